@@ -8,10 +8,17 @@ log schema with 12-bit sensors, writes the parameter file a USER would have for 
 (nameplate, DC resistance, no-load and locked-rotor tests: never the simulator's truth), and
 a manifest with the hidden effects, their true sizes and the machines' true values. The guard
 is `sim-host/tests/ladder_third_party.rs`; README.md beside this file says how to run it.
+The user-law logs (issue 85, `USER_LAW_LOGS`) hide laws the monitor's library lacks, each
+with the law file a user would write for it (`laws/`) and, for the foreign magnetising
+curve, the machine's no-load test table.
 
     python3 -m venv /tmp/mvenv && /tmp/mvenv/bin/pip install -r requirements.txt
     /tmp/mvenv/bin/python generate.py            # all logs into sim-host/tests/data/motulator
     /tmp/mvenv/bin/python generate.py --only kw2p2_fan --out /tmp/x
+
+With --only, the logs not named keep the entries the manifest on disk holds (and so do the
+machines whose parameter file comes out the same: the tests' readings differ in their last
+digits from one CPU to another); without such a manifest (another --out) none is written.
 
 What motulator does and what this script does
 ---------------------------------------------
@@ -21,6 +28,14 @@ What motulator does and what this script does
   mechanics are motulator's `StiffMechanicalSystem` (`B_L(|w_M|) w_M + tau_L(t)`: a fan is
   `B_L = k |w_M|`, dry friction `B_L = T_c tanh(|w_M|/w_0)/|w_M|`), or its
   `ExternalRotorSpeed` for the locked-rotor test.
+- A load law of the shaft's angle (the user-law logs): motulator's mechanics take loads of
+  t and w only, so `ShaftWithAngle` (a motulator `Subsystem` written here) holds the speed
+  and the shaft's mechanical angle as states, J dw_M/dt = tau_M - b w_M - T_L(t, w_M,
+  theta_M), dtheta_M/dt = w_M, theta_M = 0 at t = 0: a compressor t0 + a sin(k theta_M +
+  phi) pulsing k times per revolution, a pump k |w_M|^n sign(w_M).
+- A foreign magnetising curve: the same callable L_s(|psi_s|) of motulator's machine with a
+  tanh curve psi = psi_sat tanh(L_u i_m / psi_sat) in place of the library's form
+  (`tanh_l_s`: L_s = psi / i_m(psi), i_m = (psi_sat / L_u) atanh(psi / psi_sat)).
 - Direct-on-line runs: motulator's `Drive` needs a converter, so the supply is an ideal
   three-phase source written here (`IdealSupply`, a motulator `Subsystem`) joined to the
   machine and the mechanics in a motulator `Model` (`DirectOnLine`); its right-hand side
@@ -45,6 +60,13 @@ Buildings library (`IM_10HP_400V_50Hz`), and Krause, Wasynczuk and Sudhoff's 50 
 460 V 60 Hz machine (Analysis of Electric Machinery and Drive Systems). Each log starts
 direct-on-line from standstill (but the V/f log, which starts from standstill under V/f
 control); "variac" steps the supply voltage down 15 %, up to +10 % and back. See `LOGS`.
+
+The user-law logs (`USER_LAW_LOGS`, manifest.toml's [[user_law_log]]): a compressor pulsing
+once (2.2 kW) and twice (7.5 kW) per revolution, a pump k |w|^2.7 (7.5 kW), and the 2.2 kW
+machine with a tanh magnetising curve; the law files a user would write (`UserLaw`: starts
+25-60 % off the truth, `check_starts`) into `laws/`, and the no-load test table
+(`noload_table`: the shaft free, 30 % to 120 % of the rated voltage at rated frequency, RMS
+line voltage and phase current to 4 significant digits, `v_ll_rms_V,i0_rms_A`).
 
 The user's parameter file (`ieee112_file`)
 ------------------------------------------
@@ -83,6 +105,7 @@ import json
 import math
 import pathlib
 import time
+import tomllib
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 
@@ -134,6 +157,10 @@ class Machine:
     i_rated_a: float | None = None  # a published nameplate current, else computed
     t_rated_nm: float | None = None  # a published rated torque, else computed
     saturation: dict | None = None  # Gamma L_s(psi) = L_su / (1 + (psi/psi_k)^S)
+    # A foreign magnetising curve (not of the monitor's library form), Gamma model:
+    # psi(i_m) = psi_s tanh(L_u i_m / psi_s), so L_s(psi) = psi / i_m(psi) with
+    # i_m(psi) = (psi_s / L_u) atanh(psi / psi_s).
+    tanh_curve: dict | None = None
 
     @property
     def n_p(self) -> int:
@@ -154,13 +181,20 @@ class Machine:
         return {"R_s": self.rs, "R_R": self.rr * (self.lm / lr) ** 2,
                 "L_sgm": ls - self.lm ** 2 / lr, "L_M": self.lm ** 2 / lr}
 
-    def pars(self, saturating: bool = False) -> InductionMachinePars:
-        """motulator's Gamma-model parameters (with the saturation law if asked)."""
+    def pars(self, sat: str | None = None) -> InductionMachinePars:
+        """motulator's Gamma-model parameters, with a main-flux saturation law if asked:
+        `sat` "qu2012" (motulator's law of the machine, `saturation`) or "tanh" (the
+        foreign curve, `tanh_curve`)."""
         ig = InductionMachineInvGammaPars(n_p=self.n_p, **self.inv_gamma())
         par = InductionMachinePars.from_inv_gamma_model_pars(ig)
-        if saturating:
+        if sat == "qu2012":
             s = self.saturation
             par.L_s = lambda psi, s=s: s["L_su"] / (1 + (psi / s["psi_k"]) ** s["S"])
+        elif sat == "tanh":
+            c = self.tanh_curve
+            par.L_s = lambda psi, c=c: tanh_l_s(psi, c["psi_s"], c["L_u"])
+        elif sat is not None:
+            raise ValueError(f"unknown saturation law {sat!r}")
         return par
 
     def steady(self, slip: float, v_scale: float = 1.0) -> SimpleNamespace:
@@ -216,7 +250,8 @@ MACHINES = {
         v_ll=400.0, f_hz=50.0, poles=4, rs=3.7, rr=2.1, lls=0.021, llr=0.0, lm=0.224,
         j=0.015, b=0.005, p_rated_w=2200.0, design="B", j_datasheet_factor=1.0,
         i_rated_a=5.0, t_rated_nm=14.6,
-        saturation={"L_su": 0.34, "psi_k": 1 / 0.84, "S": 7.0}),
+        saturation={"L_su": 0.34, "psi_k": 1 / 0.84, "S": 7.0},
+        tanh_curve={"psi_s": 1.32, "L_u": 0.33}),
     "kw7p5": Machine(
         name="kw7p5", title="7.5 kW (10 hp), 400 V, 50 Hz, 4 poles (Simscape preset)",
         source=("MATLAB/Simscape asynchronous machine preset 10 hp (7.5 kW) 400 V 50 Hz as "
@@ -242,6 +277,28 @@ MACHINES = {
 }
 # IEEE 112 / NEMA: the stator's share of the locked-rotor leakage reactance.
 X1_SHARE = {"A": 0.5, "B": 0.4, "C": 0.3, "D": 0.5}
+
+# Where the foreign curve's inverse i_m(psi) goes on in a straight line (psi/psi_s): a guard
+# that keeps the current finite. The log's flux stays below it (checked in `simulate_dol`;
+# 0.925 psi_s at most, the solver's trial stages included); the tests' inrush from zero flux
+# goes beyond it at high voltage (1.04 psi_s at 120 %), which their readings, taken after
+# 4 s in the steady state, do not see.
+TANH_X_MAX = 0.995
+
+
+def tanh_l_s(psi, psi_s, l_u):
+    """The foreign curve's Gamma stator inductance L_s(|psi_s|) = psi / i_m(psi), with
+    i_m(psi) = (psi_s / L_u) atanh(psi / psi_s) (psi = psi_s tanh(L_u i_m / psi_s)); L_u at
+    psi = 0. Beyond psi / psi_s = TANH_X_MAX, i_m goes on along its tangent (finite for
+    the solver's trial stages)."""
+    x = np.abs(np.asarray(psi, dtype=float)) / psi_s
+    xc = np.minimum(x, TANH_X_MAX)
+    small = xc < 1e-6
+    ratio = np.where(small, 1.0, xc / np.arctanh(np.where(small, 0.5, xc)))  # x / atanh x
+    beyond = (x - xc) / (1 - TANH_X_MAX ** 2)  # the tangent's part, in units of psi_s/L_u
+    i_scaled = np.where(x > TANH_X_MAX, np.arctanh(TANH_X_MAX) + beyond, 0.0)
+    out = np.where(x > TANH_X_MAX, l_u * x / np.maximum(i_scaled, 1e-300), l_u * ratio)
+    return float(out) if np.ndim(out) == 0 else out
 
 
 # --------------------------------------------------------------------------- motulator parts
@@ -281,6 +338,31 @@ class HeatedMachine(model.InductionMachine):
     def set_outputs(self, t):
         self.par.R_s, self.par.R_r = self._r_s(t), self._r_r(t)
         super().set_outputs(t)
+
+
+class ShaftWithAngle(Subsystem):
+    """A stiff shaft whose load torque is a law of the time, the speed and the shaft's
+    mechanical angle (written here: motulator's mechanics take loads of t and w only):
+
+        J dw_M/dt = tau_M - b w_M - T_L(t, w_M, theta_M),   dtheta_M/dt = w_M,
+
+    with the angle a state, 0 at t = 0 (the log's start), integrated from the speed
+    (not wrapped). b is the machine's own viscous friction."""
+
+    def __init__(self, J, b, load):
+        super().__init__()
+        self.J, self.b, self.load = J, b, load
+        self.state = SimpleNamespace(w_M=0.0, theta_M=0.0)
+        self.sol_states = SimpleNamespace(w_M=[], theta_M=[])
+
+    def set_outputs(self, t):
+        w, theta = np.real(self.state.w_M), np.real(self.state.theta_M)
+        self.out.w_M = w
+        self.out.tau_L = self.load(t, w, theta)
+
+    def rhs(self):
+        w = self.out.w_M
+        return [(np.real(self.inp.tau_M) - self.b * w - self.out.tau_L) / self.J, w]
 
 
 def half_period_zoh(T_s, d_c_abc):
@@ -350,10 +432,39 @@ class Log:
     rs_factor: float = 1.0  # constant stator resistance over the file's (cold) value
     drift: dict | None = None  # {"rise_k", "tau_s", "rotor": bool}
     saturating: bool = False
+    curve: str = "qu2012"  # the saturation law when saturating: "qu2012" or "tanh"
     vf_profile: list = field(default_factory=list)  # (t, speed reference in per unit)
     allowed: list = field(default_factory=list)
     equivalent: list = field(default_factory=list)  # (hidden, named, why)
     seed: int = 1
+    # A load law the library lacks (the user-law logs): {"kind": "pulse", "order",
+    # "t0_share", "a_share", "phi"} for t0 + a sin(order theta_m + phi), shares of rated
+    # torque; {"kind": "power", "k", "n"} for k |w|^n sign(w) [N m (s/rad)^n]. On
+    # `ShaftWithAngle`.
+    load_law: dict | None = None
+    law: "UserLaw | None" = None  # the user's law file for this log
+    noload_table: str | None = None  # also write this machine's no-load table (CSV name)
+
+    @property
+    def sat(self) -> str | None:
+        """The main-flux saturation law (None: a linear machine)."""
+        return self.curve if self.saturating else None
+
+
+@dataclass
+class UserLaw:
+    """A user's law file (issue 85's form): what a user writes knowing the physics but not
+    the numbers. `parameters`: name -> (start, low, high, unit), written as literals here
+    as a user would; `main` checks each start is 25-60 % off the truth and the truth inside
+    the bounds."""
+
+    file: str  # under laws/
+    name: str
+    acts_on: str
+    comment: str
+    expr: str | None = None
+    parameters: dict = field(default_factory=dict)
+    table: str | None = None  # relative to the laws file
 
 
 COULOMB_EQ = ("coulomb_friction", "load_torque",
@@ -416,6 +527,68 @@ LOGS = [
         5.0, ["load_torque"], {}, torque_steps=[(2.0, 0.4), (3.5, 0.9)], seed=32),
 ]
 
+# The user-law logs (issue 85): each hides a law the monitor's library lacks, and comes with
+# the law file a user would write for it. In manifest.toml as [[user_law_log]], apart from
+# the library guard's [[log]]s.
+USER_LAW_LOGS = [
+    Log("kw2p2_pulse1", "kw2p2", "direct-on-line start driving a reciprocating compressor "
+        "(a load torque pulsing once per revolution, t0 + a sin(theta_m + phi), theta_m "
+        "the shaft's angle, 0 at the log's start), no viscous load, variac steps", 4.0,
+        ["compressor"], {}, variac=variac(0.6),
+        load_law={"kind": "pulse", "order": 1, "t0_share": 0.65, "a_share": 0.25,
+                  "phi": 0.9},
+        law=UserLaw("compressor1.toml", "compressor", "load_torque",
+                    "a reciprocating compressor whose torque pulses once per revolution",
+                    expr="t0 + a * sin(theta + phi)",
+                    parameters={"t0": (5.0, 0.0, 40.0, "N m"),
+                                "a": (2.0, 0.0, 20.0, "N m"),
+                                "phi": (0.5, -3.1416, 3.1416, "rad")}),
+        seed=41),
+    Log("kw7p5_pulse2", "kw7p5", "direct-on-line start driving a two-cylinder compressor "
+        "(a load torque pulsing twice per revolution, t0 + a sin(2 theta_m + phi)), no "
+        "viscous load, variac steps", 4.0, ["compressor"], {}, variac=variac(0.6),
+        load_law={"kind": "pulse", "order": 2, "t0_share": 0.6, "a_share": 0.3,
+                  "phi": -1.2},
+        law=UserLaw("compressor2.toml", "compressor", "load_torque",
+                    "a compressor whose torque pulses twice per revolution",
+                    expr="t0 + a * sin(2*theta + phi)",
+                    parameters={"t0": (15.0, 0.0, 120.0, "N m"),
+                                "a": (8.0, 0.0, 60.0, "N m"),
+                                "phi": (-0.6, -3.1416, 3.1416, "rad")}),
+        seed=42),
+    Log("kw7p5_pump", "kw7p5", "direct-on-line start driving a pump (load torque k "
+        "|w|^2.7 sign(w), no viscous load besides the machine's own), variac steps", 4.0,
+        ["pump"], {}, variac=variac(0.6),
+        load_law={"kind": "power", "k": 5.0e-5, "n": 2.7},
+        law=UserLaw("pump.toml", "pump", "load_torque",
+                    "a pump whose torque goes with a power of the speed",
+                    expr="k * abs(w)^n * sign(w)",
+                    parameters={"k": (7.5e-5, 0.0, 1.0, "N m (s/rad)^n"),
+                                "n": (2.0, 1.5, 3.5, "1")}),
+        seed=43),
+    Log("kw2p2_foreign_sat", "kw2p2", "direct-on-line start, viscous load 80 %, variac "
+        "steps (-15 %, +10 %); a saturating machine whose magnetising curve is not of the "
+        "library's form (psi = psi_s tanh(L_u i_m / psi_s))", 4.0, ["no-load test"], {},
+        variac=variac(0.6), bl_share=0.8, saturating=True, curve="tanh",
+        noload_table="kw2p2_noload.csv",
+        law=UserLaw("noload.toml", "no-load test", "magnetising_curve",
+                    "the machine's magnetising curve as its no-load test measured it",
+                    table="../kw2p2_noload.csv"),
+        seed=44),
+]
+
+# The library's laws that share a term with a user-law log's true law (information for the
+# tests; not an allowance): name -> why.
+LIBRARY_OVERLAP = {
+    "pulse": [["load_torque", "the pulsing law's mean t0 is a constant load torque"]],
+    "power": [["windage", "the library's windage k w|w| is the same law with n = 2"]],
+    "tanh": [["saturation", "the library's saturation law is another curve of the same "
+              "effect (Lm0 / (1 + (psi/psi_sat)^n)), which cannot follow a tanh curve"]],
+}
+
+# The no-load table's supply voltages (shares of the rated line voltage), rated frequency.
+NOLOAD_SCALES = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2]
+
 
 # --------------------------------------------------------------------------- simulation
 def thermal(m: Machine, lg: Log):
@@ -437,14 +610,31 @@ def thermal(m: Machine, lg: Log):
 
 
 def machine_of(m: Machine, lg: Log):
-    par = m.pars(saturating=lg.saturating)
+    par = m.pars(lg.sat)
     if lg.rs_factor == 1.0 and lg.drift is None:
         return model.InductionMachine(par)
     return HeatedMachine(par, *thermal(m, lg))
 
 
+def load_law_of(m: Machine, lg: Log):
+    """A user-law log's load torque T_L(t, w, theta) [N m] and its true parameters."""
+    r, law = m.rated(), lg.load_law
+    if law["kind"] == "pulse":
+        t0, a, phi, k = law["t0_share"] * r.t, law["a_share"] * r.t, law["phi"], law["order"]
+        return (lambda t, w, theta: t0 + a * np.sin(k * theta + phi),
+                {"t0": t0, "a": a, "phi": phi})
+    if law["kind"] == "power":
+        k, n = law["k"], law["n"]
+        return (lambda t, w, theta: k * np.abs(w) ** n * np.sign(w), {"k": k, "n": n})
+    raise ValueError(law["kind"])
+
+
 def mechanics_of(m: Machine, lg: Log):
     r = m.rated()
+    if lg.load_law is not None:
+        if lg.bl_share or lg.torque_steps or lg.fan_k or lg.fan_share or lg.coulomb_share:
+            raise ValueError(f"{lg.name}: a load law takes the whole load")
+        return ShaftWithAngle(m.j, m.b, load_law_of(m, lg)[0]), 0.0, None
     fan_k = lg.fan_k if lg.fan_k is not None else lg.fan_share * r.t / (m.w_s / m.n_p) ** 2
     coulomb = (lg.coulomb_share * r.t, lg.coulomb_w0) if lg.coulomb_share else None
     b_l = friction(m.b, lg.bl_share * r.t / r.w_m, fan_k, coulomb)
@@ -498,6 +688,10 @@ def simulate_dol(m: Machine, lg: Log):
     t = np.arange(n) / lg.rate_hz
     breaks = [p[0] for p in lg.variac] + [p[0] for p in lg.torque_steps]
     y = integrate(mdl, mdl.get_initial_values(), lg.duration_s, t, breaks)
+    if lg.sat == "tanh":
+        x = float(np.max(np.abs(y[0]))) / m.tanh_curve["psi_s"]
+        if x >= TANH_X_MAX:
+            raise RuntimeError(f"{lg.name}: the flux reached {x:.4f} psi_s")
     i_ss = currents(machine, y[0], y[1])
     return t, u_ss(t), i_ss, y[2].real
 
@@ -572,10 +766,11 @@ def readings(t, u_ss, i_ss, w_m):
             "speed_rad_s": float(np.mean(w_m))}
 
 
-def run_test(m: Machine, saturating, mechanics, v_scale, seconds):
-    """A steady test: motulator's machine on a balanced supply at v_scale x rated for
-    `seconds`; the readings over its last 20 periods (200 points each)."""
-    machine = model.InductionMachine(m.pars(saturating=saturating))
+def run_test(m: Machine, sat, mechanics, v_scale, seconds):
+    """A steady test: motulator's machine (saturation law `sat`, see `Machine.pars`) on a
+    balanced supply at v_scale x rated for `seconds`; the readings over its last 20
+    periods (200 points each)."""
+    machine = model.InductionMachine(m.pars(sat))
     w, u = m.w_s, m.u_peak * v_scale
 
     def u_ss(t):
@@ -589,29 +784,43 @@ def run_test(m: Machine, saturating, mechanics, v_scale, seconds):
     return readings(t, u_ss(t), currents(machine, y[0], y[1]), w_m)
 
 
-def no_load_test(m: Machine, saturating):
+def no_load_test(m: Machine, sat, v_scale=1.0):
     mech = model.StiffMechanicalSystem(J=m.j, B_L=m.b)
     mech.state.w_M = m.w_s / m.n_p  # started and run up beforehand
     seconds = 4.0 if m.j < 1 else 12.0
-    return run_test(m, saturating, mech, 1.0, seconds)
+    return run_test(m, sat, mech, v_scale, seconds)
 
 
-def locked_rotor_test(m: Machine, saturating):
+def noload_table(m: Machine, sat, path):
+    """A lab's no-load test table: the shaft free (the machine's own friction only), rated
+    frequency, the supply at each of NOLOAD_SCALES x rated; the steady RMS line voltage and
+    RMS phase current, rounded like a meter to 4 significant digits."""
+    def meter(v):
+        return f"{v:#.4g}".rstrip(".")
+
+    rows = [no_load_test(m, sat, k) for k in NOLOAD_SCALES]
+    lines = ["v_ll_rms_V,i0_rms_A"] + [f"{meter(r['v_ll_v'])},{meter(r['i_a'])}"
+                                       for r in rows]
+    path.write_text("\n".join(lines) + "\n")
+    return rows
+
+
+def locked_rotor_test(m: Machine, sat):
     """Rotor held, rated frequency, voltage lowered until the current is rated."""
     i_rated = m.rated().i
     v_scale = 0.25
     for _ in range(4):
         mech = model.ExternalRotorSpeed()
-        r = run_test(m, saturating, mech, v_scale, 3.0)
+        r = run_test(m, sat, mech, v_scale, 3.0)
         v_scale *= i_rated / r["i_a"]
     r["v_scale"] = v_scale
     return r
 
 
-def ieee112_file(m: Machine, saturating):
+def ieee112_file(m: Machine, sat):
     """The parameter file a user derives (module docstring): values and the readings."""
-    lr = locked_rotor_test(m, saturating)
-    nl = no_load_test(m, saturating)
+    lr = locked_rotor_test(m, sat)
+    nl = no_load_test(m, sat)
     w = m.w_s
     rs = m.rs  # the DC test: cold, exact
     r_lr = lr["p_w"] / 3 / lr["i_a"] ** 2
@@ -641,9 +850,16 @@ def off_pct(value, truth):
     return None if truth == 0 else 100.0 * (value / truth - 1.0)
 
 
-def write_params(path, m: Machine, f, saturating):
-    what = ("a saturating machine (motulator's saturation law): lm_h is the no-load "
-            "test's rated-point value" if saturating else "")
+# The parameter file's name's suffix and its comment, per saturation law.
+SAT_FILES = {None: ("", ""),
+             "qu2012": ("_saturating", "a saturating machine (motulator's saturation law): "
+                        "lm_h is the no-load test's rated-point value"),
+             "tanh": ("_foreign_sat", "a saturating machine (a tanh magnetising curve, not "
+                      "of the library's form): lm_h is the no-load test's rated-point value")}
+
+
+def write_params(path, m: Machine, f, sat):
+    what = SAT_FILES[sat][1]
     lines = [
         f"# {m.title}: the parameter file a user derives, not the simulator's values.",
         "# Made by tools/motulator-logs/generate.py: nameplate (voltage, frequency, poles),",
@@ -724,19 +940,159 @@ def log_sizes(m: Machine, lg: Log, fan_k, coulomb):
         end = d["rise_k"] * (1 - math.exp(-lg.duration_s / d["tau_s"]))
         s["drift_rise_at_end_k"] = end
         s["drift_resistance_at_end"] = 1 + ALPHA_CU * end
-    if lg.saturating:
+    if lg.sat == "qu2012":
         sat = m.saturation
         s["saturation_law"] = ("motulator Gamma model: L_s(psi_s) = L_su / (1 + "
                                "(|psi_s|/psi_k)^S)")
         s["saturation_L_su_h"], s["saturation_psi_k_wb"] = sat["L_su"], sat["psi_k"]
         s["saturation_S"] = sat["S"]
-        s["saturation_L_s_at_rated_flux_h"] = m.pars(True).L_s(m.u_peak / m.w_s)
+        s["saturation_L_s_at_rated_flux_h"] = m.pars("qu2012").L_s(m.u_peak / m.w_s)
+    if lg.sat == "tanh":
+        c = m.tanh_curve
+        s["saturation_law"] = ("motulator Gamma model, a tanh magnetising curve: psi_s = "
+                               "psi_sat tanh(L_u i_m / psi_sat), i.e. L_s(psi) = psi / i_m, "
+                               "i_m = (psi_sat / L_u) atanh(psi / psi_sat)")
+        s["saturation_psi_sat_wb"], s["saturation_L_u_h"] = c["psi_s"], c["L_u"]
+        psi_r = m.u_peak / m.w_s
+        s["saturation_rated_flux_wb"] = psi_r
+        s["saturation_L_s_at_rated_flux_h"] = m.pars("tanh").L_s(psi_r)
+        s["saturation_L_s_ratio_at_rated_flux"] = m.pars("tanh").L_s(psi_r) / c["L_u"]
+    if lg.load_law is not None:
+        law, true = lg.load_law, load_law_of(m, lg)[1]
+        if law["kind"] == "pulse":
+            s["load_law"] = f"T_L = t0 + a sin({law['order']} theta_m + phi)"
+            s["load_t0_nm"], s["load_a_nm"], s["load_phi_rad"] = (
+                true["t0"], true["a"], true["phi"])
+            s["load_pulses_per_revolution"] = law["order"]
+        else:
+            s["load_law"] = "T_L = k |w_m|^n sign(w_m)"
+            s["load_k"], s["load_n"] = true["k"], true["n"]
+            s["load_k_unit"] = "N m (s/rad)^n"
+            s["load_torque_at_synchronous_speed_nm"] = true["k"] * (m.w_s / m.n_p) ** true["n"]
     if lg.drive == "vf":
         s["vf_speed_reference_pu"] = [list(p) for p in lg.vf_profile]
         s["vf_control"] = ("motulator VHzControl (k_u 1, k_w 4), T_s 125 us, average "
                            "converter, 650 V DC bus, the control's model the machine's "
                            "nominal values")
     return s
+
+
+def sat_order(key):
+    """Parameter files in the order machine, linear before saturating."""
+    return key[0], key[1] is not None, key[1] or ""
+
+
+def shaft_frequencies(t, w, lg: Log, order):
+    """The true shaft frequency [Hz] of each steady stretch (between the supply's steps;
+    the mean noise-free speed over the stretch's last 0.3 s, about 7 revolutions) and the
+    amplitude of the speed's line at `order` x the shaft frequency there (its projection
+    on exp(-j order theta_m), theta_m integrated from the speed)."""
+    theta = np.concatenate([[0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) * np.diff(t))])
+    edges = [0.0] + [p[0] for p in lg.variac] + [lg.duration_s]
+    out = []
+    for a, b in zip(edges[:-1], edges[1:]):
+        sel = (t >= b - 0.3) & (t < b)
+        f = float(np.mean(w[sel])) / math.tau
+        dw = w[sel] - np.mean(w[sel])
+        ripple = 2 * abs(np.mean(dw * np.exp(-1j * order * theta[sel])))
+        out.append([a, b, f, order * f, float(ripple)])
+    return out
+
+
+def check_starts(lg: Log, truth: dict):
+    """The user's starts are guesses, 25-60 % off the truth (the pump's exponent starts at
+    2, a fan's, 26 % below its 2.7), and the bounds hold the truth."""
+    for k, (start, low, high, _) in lg.law.parameters.items():
+        off = abs(start / truth[k] - 1)
+        if not (0.25 <= off <= 0.6 and low < truth[k] < high):
+            raise ValueError(f"{lg.law.file}: {k} start {start} is {off:.0%} off the truth "
+                             f"{truth[k]:.6g} or its bounds [{low}, {high}] miss it")
+
+
+def write_law_file(path, lg: Log):
+    """The user's law file, in issue 85's form."""
+    law = lg.law
+    lines = [f"# The user's law for {lg.name}.csv: {law.comment}.",
+             "# What a user writes knowing the physics but not the numbers: the starts are",
+             "# guesses, the bounds physical and generous. Made by tools/motulator-logs/",
+             "# generate.py; the true law and its values are in ../manifest.toml",
+             f"# ([[user_law_log]] {lg.name}).",
+             "[[law]]",
+             f"name = {toml_value(law.name)}",
+             f"acts_on = {toml_value(law.acts_on)}"]
+    if law.expr is not None:
+        lines.append(f"expr = {toml_value(law.expr)}")
+    if law.table is not None:
+        lines.append(f"table = {toml_value(law.table)}")
+    if law.parameters:
+        lines.append("[law.parameters]")
+        for k, (start, low, high, unit) in law.parameters.items():
+            lines.append(f"{k} = {{ start = {start!r}, low = {low!r}, high = {high!r}, "
+                         f"unit = {toml_value(unit)} }}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(lines) + "\n")
+
+
+def user_law_entry(m: Machine, lg: Log, out, t, w, made_table):
+    """What a [[user_law_log]] adds to a [[log]]: the law file, the true law, the library's
+    laws that share a term with it, the shaft's frequencies, the no-load table."""
+    law = lg.law
+    e = {"laws": f"laws/{law.file}", "law_name": law.name, "law_acts_on": law.acts_on}
+    if lg.load_law is not None:
+        kind, true = lg.load_law["kind"], load_law_of(m, lg)[1]
+        if kind == "pulse":
+            k = lg.load_law["order"]
+            expr = f"t0 + a * sin({k}*theta + phi)" if k != 1 else "t0 + a * sin(theta + phi)"
+        else:
+            k, expr = 1, "k * abs(w)^n * sign(w)"
+        e["true_law"] = {"acts_on": "load_torque", "expr": expr,
+                         "note": "theta the shaft's mechanical angle (rad, 0 at t = 0, "
+                                 "integrated from the speed), w the mechanical speed (rad/s)",
+                         "parameters": true}
+        e["library_overlap"] = LIBRARY_OVERLAP[kind]
+        fr = shaft_frequencies(t, w, lg, k)
+        e["frequencies"] = {
+            "note": ("per steady stretch [t_from_s, t_to_s, value]; the shaft frequency is "
+                     "the mean speed over the stretch's last 0.3 s over 2 pi"),
+            "pulses_per_revolution": k if kind == "pulse" else 0,
+            "shaft_hz": [[a, b, f] for a, b, f, _, _ in fr],
+            "supply_hz": m.f_hz,
+        }
+        if kind == "pulse":
+            e["frequencies"]["pulsation_hz"] = [[a, b, p] for a, b, _, p, _ in fr]
+            e["frequencies"]["speed_ripple_at_pulsation_rad_s"] = [
+                [a, b, r] for a, b, _, _, r in fr]
+    if lg.sat == "tanh":
+        c = m.tanh_curve
+        e["true_law"] = {"acts_on": "magnetising_curve",
+                         "expr": "psi = psi_sat * tanh(L_u * i_m / psi_sat)",
+                         "note": ("motulator's Gamma model: psi the stator flux (Wb, "
+                                  "peak), i_m the magnetising current (A, peak), "
+                                  "L_s(psi) = psi / i_m(psi)"),
+                         "parameters": {"psi_sat_wb": c["psi_s"], "L_u_h": c["L_u"]}}
+        e["library_overlap"] = LIBRARY_OVERLAP["tanh"]
+    if lg.noload_table is not None:
+        data = (out / lg.noload_table).read_bytes()
+        e["noload_table"] = {
+            "csv": lg.noload_table, "bytes": len(data),
+            "sha256": hashlib.sha256(data).hexdigest(),
+            "test": ("the machine of this log at no load (shaft free, its own friction "
+                     "b only), rated frequency, each voltage held 4 s from synchronous "
+                     "speed; RMS line voltage and RMS phase current over the last 20 "
+                     "periods, rounded to 4 significant digits"),
+            "v_scale": NOLOAD_SCALES,
+            "v_ll_rms_v": [r["v_ll_v"] for r in made_table],
+            "i0_rms_a": [r["i_a"] for r in made_table],
+            "i0_reactive_rms_a": [math.sqrt(max(r["i_a"] ** 2 - (r["p_w"] / 3 / r["v_ph_v"])
+                                                ** 2, 0.0)) for r in made_table],
+            "note": ("i0 holds the in-phase current of the no-load losses (the friction's "
+                     "b w^2 and the copper's): a large share at the lowest voltages, where "
+                     "the slip grows; i0_reactive_rms_a is its part in quadrature (from "
+                     "the power p_w, which the table does not give)"),
+            "p_w": [r["p_w"] for r in made_table],
+            "speed_rad_s": [r["speed_rad_s"] for r in made_table],
+        }
+    return e
 
 
 def main():
@@ -746,14 +1102,24 @@ def main():
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     t_all = time.time()
+    known = {lg.name for lg in LOGS + USER_LAW_LOGS}
+    for name in args.only or []:
+        if name not in known:
+            raise SystemExit(f"no log named {name!r} (known: {', '.join(sorted(known))})")
 
-    # The users' parameter files: one per machine (and per saturating variant).
-    files = {}
-    for key in sorted({(lg.machine, lg.saturating) for lg in LOGS}):
+    # The users' parameter files: one per machine (and per saturating variant); the
+    # library guard's first, then those only the user-law logs need.
+    files, unchanged = {}, set()
+    keys = sorted({(lg.machine, lg.sat) for lg in LOGS}, key=sat_order)
+    keys += sorted({(lg.machine, lg.sat) for lg in USER_LAW_LOGS} - set(keys), key=sat_order)
+    for key in keys:
         m = MACHINES[key[0]]
         f, tests = ieee112_file(m, key[1])
-        name = f"{m.name}{'_saturating' if key[1] else ''}.toml"
+        name = f"{m.name}{SAT_FILES[key[1]][0]}.toml"
+        before = (args.out / name).read_bytes() if (args.out / name).exists() else None
         write_params(args.out / name, m, f, key[1])
+        if (args.out / name).read_bytes() == before:
+            unchanged.add(name)
         files[key] = (name, f, tests)
         print(f"{name}: " + ", ".join(f"{k} {v:.4g}" for k, v in f.items()))
 
@@ -767,17 +1133,36 @@ def main():
         "# them, effects that are the same term on this log (`equivalent`: hidden, named,",
         "# why), and the true sizes. Per machine: the truth, the user's file and the tests",
         "# it came from.",
+        "# [[user_law_log]] (issue 85): logs whose hidden law the library lacks, each with",
+        "# the user's law file (`laws`, its `law_name` is what `hidden` holds), the true law",
+        "# and its values (`true_law`), the library's laws sharing a term with it",
+        "# (`library_overlap`, not an allowance) and the shaft's true frequencies.",
         "",
         toml_table("", {"motulator": MOTULATOR, "numpy": np.__version__,
                         "generator": "tools/motulator-logs/generate.py"}),
     ]
+    # A run with --only keeps the manifest's entry of a machine whose file came out the
+    # same: the tests' readings differ in their last digits from one CPU to another
+    # (numpy's SIMD sums), and the entries of the logs not made must not move.
+    old_path = args.out / "manifest.toml"
+    old = tomllib.loads(old_path.read_text()) if old_path.exists() else {}
+    old_machines = {e["params"]: e for e in old.get("machine", [])}
     for (mname, sat), (pname, f, tests) in files.items():
+        if args.only and pname in unchanged and pname in old_machines:
+            manifest.append(toml_table("[[machine]]", old_machines[pname]))
+            continue
         m = MACHINES[mname]
         r = m.rated()
         ig_t, ig_f = m.inv_gamma(), file_inv_gamma(f)
         truth = m.truth_table()
         entry = {
-            "name": mname, "saturating": sat, "params": pname, "title": m.title,
+            "name": mname, "saturating": sat is not None, "params": pname,
+            "saturation_curve": (None if sat != "tanh" else
+                                 "in place of the source's law, a tanh magnetising curve "
+                                 f"psi = psi_sat tanh(L_u i_m / psi_sat), psi_sat "
+                                 f"{m.tanh_curve['psi_s']} Wb, L_u {m.tanh_curve['L_u']} H "
+                                 "(Gamma model)"),
+            "title": m.title,
             "source": m.source,
             "nameplate": {"v_ll_rms": m.v_ll, "f_hz": m.f_hz, "poles": m.poles,
                           "p_w": m.p_rated_w, "i_a": r.i, "speed_rpm": r.w_m * 60 / math.tau,
@@ -792,16 +1177,27 @@ def main():
         }
         manifest.append(toml_table("[[machine]]", entry))
 
-    for lg in LOGS:
+    # A log not made in this run keeps the entry the manifest on disk holds (a run with
+    # --only rewrites the manifest only when it knows every log's entry).
+    old_entries = {(arr, e["name"]): e for arr in ("log", "user_law_log")
+                   for e in old.get(arr, [])}
+    complete = True
+    for arr, lg in [("log", x) for x in LOGS] + [("user_law_log", x) for x in USER_LAW_LOGS]:
         if args.only and lg.name not in args.only:
+            if (arr, lg.name) in old_entries:
+                manifest.append(toml_table(f"[[{arr}]]", old_entries[(arr, lg.name)]))
+            else:
+                complete = False
             continue
         m = MACHINES[lg.machine]
+        if lg.load_law is not None:
+            check_starts(lg, load_law_of(m, lg)[1])
         t0 = time.time()
         t, u, i, w = (simulate_vf if lg.drive == "vf" else simulate_dol)(m, lg)
         csv = args.out / f"{lg.name}.csv"
         sensors = write_csv(csv, t, u, i, w, m, lg.seed)
         _, fan_k, coulomb = mechanics_of(m, lg)
-        pname = files[(lg.machine, lg.saturating)][0]
+        pname = files[(lg.machine, lg.sat)][0]
         data = csv.read_bytes()
         entry = {
             "name": lg.name, "csv": csv.name, "params": pname, "machine": lg.machine,
@@ -813,15 +1209,22 @@ def main():
             "equivalent": [list(e) for e in lg.equivalent],
             "stator_at_file_temperature": lg.rs_factor == 1.0 and lg.drift is None,
             "warm_stator": lg.rs_factor - 1.0 if lg.rs_factor != 1.0 else None,
-            "sizes": log_sizes(m, lg, fan_k, coulomb),
-            "sensors": sensors,
         }
-        manifest.append(toml_table("[[log]]", entry))
+        if lg.law is not None:
+            table = (noload_table(m, lg.sat, args.out / lg.noload_table)
+                     if lg.noload_table else None)
+            write_law_file(args.out / "laws" / lg.law.file, lg)
+            entry.update(user_law_entry(m, lg, args.out, t, w, table))
+        entry["sizes"] = log_sizes(m, lg, fan_k, coulomb)
+        entry["sensors"] = sensors
+        manifest.append(toml_table(f"[[{arr}]]", entry))
         print(f"{lg.name}: {len(t)} rows, {len(data) / 1e6:.2f} MB, peak current "
               f"{sensors['peak_current_a']:.1f} A of {sensors['i_range_a']} A, "
               f"{time.time() - t0:.1f} s")
-    if not args.only:
-        (args.out / "manifest.toml").write_text("\n".join(manifest))
+    if complete:
+        old_path.write_text("\n".join(manifest))
+    else:
+        print(f"{old_path} not written: it does not hold every log not made in this run")
     print(f"done in {time.time() - t_all:.0f} s")
 
 
