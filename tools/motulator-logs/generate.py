@@ -530,6 +530,11 @@ LOGS = [
 # The user-law logs (issue 85): each hides a law the monitor's library lacks, and comes with
 # the law file a user would write for it. In manifest.toml as [[user_law_log]], apart from
 # the library guard's [[log]]s.
+# The pump's law as its user writes it: the torque t1 at a reference speed (150 rad/s,
+# near the running speed) and the exponent n, k = t1 / 150^n.
+PUMP_W_REF = 150.0
+PUMP_EXPR = "t1 * (abs(w) / 150)^n * sign(w)"
+
 USER_LAW_LOGS = [
     Log("kw2p2_pulse1", "kw2p2", "direct-on-line start driving a reciprocating compressor "
         "(a load torque pulsing once per revolution, t0 + a sin(theta_m + phi), theta_m "
@@ -562,8 +567,8 @@ USER_LAW_LOGS = [
         load_law={"kind": "power", "k": 5.0e-5, "n": 2.7},
         law=UserLaw("pump.toml", "pump", "load_torque",
                     "a pump whose torque goes with a power of the speed",
-                    expr="k * abs(w)^n * sign(w)",
-                    parameters={"k": (7.5e-5, 0.0, 1.0, "N m (s/rad)^n"),
+                    expr=PUMP_EXPR,
+                    parameters={"t1": (25.0, 0.0, 200.0, "N m"),
                                 "n": (2.0, 1.5, 3.5, "1")}),
         seed=43),
     Log("kw2p2_foreign_sat", "kw2p2", "direct-on-line start, viscous load 80 %, variac "
@@ -625,7 +630,11 @@ def load_law_of(m: Machine, lg: Log):
                 {"t0": t0, "a": a, "phi": phi})
     if law["kind"] == "power":
         k, n = law["k"], law["n"]
-        return (lambda t, w, theta: k * np.abs(w) ** n * np.sign(w), {"k": k, "n": n})
+        # The user's law is written with the torque at a reference speed (`t1` at
+        # PUMP_W_REF), whose parameters the log shows apart: k and n of k |w|^n trade
+        # along a valley over the log's narrow range of running speed.
+        return (lambda t, w, theta: k * np.abs(w) ** n * np.sign(w),
+                {"t1": k * PUMP_W_REF ** n, "n": n})
     raise ValueError(law["kind"])
 
 
@@ -965,10 +974,11 @@ def log_sizes(m: Machine, lg: Log, fan_k, coulomb):
                 true["t0"], true["a"], true["phi"])
             s["load_pulses_per_revolution"] = law["order"]
         else:
-            s["load_law"] = "T_L = k |w_m|^n sign(w_m)"
-            s["load_k"], s["load_n"] = true["k"], true["n"]
+            k = law["k"]
+            s["load_law"] = "T_L = k |w_m|^n sign(w_m) = t1 (|w_m| / 150 rad/s)^n sign(w_m)"
+            s["load_k"], s["load_n"], s["load_t1_nm"] = k, true["n"], true["t1"]
             s["load_k_unit"] = "N m (s/rad)^n"
-            s["load_torque_at_synchronous_speed_nm"] = true["k"] * (m.w_s / m.n_p) ** true["n"]
+            s["load_torque_at_synchronous_speed_nm"] = k * (m.w_s / m.n_p) ** true["n"]
     if lg.drive == "vf":
         s["vf_speed_reference_pu"] = [list(p) for p in lg.vf_profile]
         s["vf_control"] = ("motulator VHzControl (k_u 1, k_w 4), T_s 125 us, average "
@@ -1044,7 +1054,7 @@ def user_law_entry(m: Machine, lg: Log, out, t, w, made_table):
             k = lg.load_law["order"]
             expr = f"t0 + a * sin({k}*theta + phi)" if k != 1 else "t0 + a * sin(theta + phi)"
         else:
-            k, expr = 1, "k * abs(w)^n * sign(w)"
+            k, expr = 1, PUMP_EXPR
         e["true_law"] = {"acts_on": "load_torque", "expr": expr,
                          "note": "theta the shaft's mechanical angle (rad, 0 at t = 0, "
                                  "integrated from the speed), w the mechanical speed (rad/s)",

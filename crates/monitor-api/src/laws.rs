@@ -24,18 +24,17 @@ pub fn read_laws(path: Option<&Path>) -> Result<Vec<Arc<Law>>, ApiError> {
 }
 
 /// Checks the laws that need the machine against the parameter file `params`: a no-load
-/// table's voltages must fit its rated voltage and give a flux that rises with the current
-/// with its Rs and stator leakage.
+/// table's voltages must fit its rated voltage and give a stator flux that rises with the
+/// current with its Rs.
 ///
 /// # Errors
 /// [`ApiError::Laws`] naming the law and the problem.
 pub fn check_laws(laws: &[Arc<Law>], params: &ParamFile) -> Result<(), ApiError> {
-    let m = params.motor.model::<f64>();
     for law in laws {
         let Some(t) = law.table() else { continue };
         t.curve(
-            m.rs_ohm,
-            m.lls_h(),
+            params.motor.rs_ohm,
+            0.0,
             params.supply.v_ll_rms,
             params.supply.f_hz,
         )

@@ -120,11 +120,12 @@ impl ResolvedEffects {
                     self.mag_law = Some(match b.law.table() {
                         None => MagLaw::Law(b.clone()),
                         Some(t) => {
-                            let model = m.model::<f64>();
-                            let curve = t
+                            // The stator inductance of the stator flux (no leakage taken
+                                // off): the machine runs as its Gamma circuit.
+                                let curve = t
                                 .curve(
                                     m.rs_ohm,
-                                    model.lls_h(),
+                                    0.0,
                                     rated.vpk0 * 1.5f64.sqrt(),
                                     rated.we0 / (2.0 * PI),
                                 )
@@ -355,8 +356,20 @@ impl MachineBuilder<'_> {
         if gamma_r {
             lm *= md.llr;
         }
-        let lls = if gamma_s { 0.0 } else { model.lls_h() * md.lls };
-        let llr = if gamma_r { 0.0 } else { model.llr_h() * md.llr };
+        let mut lls = if gamma_s { 0.0 } else { model.lls_h() * md.lls };
+        let mut llr = if gamma_r { 0.0 } else { model.llr_h() * md.llr };
+        let mut rr = rr;
+        if matches!(self.eff.mag_law, Some(MagLaw::Curve(_))) {
+            // A no-load curve is the stator inductance of the stator flux: the machine as
+            // its Gamma circuit (no stator leakage; the rotor leakage
+            // Ls (Ls Lr / Lm^2 - 1) and the rotor resistance Rr (Ls/Lm)^2 keep its
+            // terminal behaviour), Lm the curve's Ls.
+            let (ls, lr) = (lls + lm, llr + lm);
+            llr = ls * (ls * lr / (lm * lm) - 1.0);
+            rr *= (ls / lm).powi(2);
+            lls = 0.0;
+            lm = ls;
+        }
         // The fault resistance defaults to a tenth of the healthy phase's (cold) Rs.
         let turn = self.eff.asym.filter(|a| a.1 > 0.0).map(|(ph, mu, rf)| {
             TurnLoop::new(ph, mu, rf.unwrap_or(0.1 * m.rs_ohm), rs, model.lls_h())

@@ -7,11 +7,15 @@
 //!   span's first sample), added to eq. (29)'s torque balance;
 //! - `stator_resistance`, `rotor_resistance`: the resistance per sample over the parameter
 //!   file's value, on Rs, or on Rr alone (both scaled, the stator's scale divided back);
-//! - `magnetising_inductance`, `magnetising_curve`: Lm of the magnetising flux, as the
-//!   library's saturation acts: per sample from the measured magnetising current in the
-//!   reduced model (`psi_m = Lm(psi_m) |i_f|`, solved on a grid of currents and
-//!   interpolated), and on the model's own flux in the full-order model
-//!   ([`MagnetisingLaw::Shape`]).
+//! - `magnetising_inductance`: Lm of the magnetising flux, as the library's saturation
+//!   acts: per sample from the measured magnetising current in the reduced model
+//!   (`psi_m = Lm(psi_m) |i_f|`, solved on a grid of currents and interpolated), and on the
+//!   model's own flux in the full-order model ([`MagnetisingLaw::Shape`]);
+//! - `magnetising_curve`: a no-load test's curve is the stator inductance Ls of the stator
+//!   flux (`psi_s = sqrt(V^2 - (Rs I)^2) / w`, `Ls = psi_s / I`: what the test measures,
+//!   whatever split of the leakage the file holds), so the full-order model saturates
+//!   the Gamma-equivalent circuit (no stator leakage, the machine's transient inductance
+//!   on the rotor side) on its stator flux; the reduced model takes `Ls - Lls` as its Lm.
 //!
 //! Its parameters are fitted from their start within their bounds (which are also their
 //! physical range: a value pinned at a bound is refused as the library's are); a parameter
@@ -167,7 +171,7 @@ impl EffectModel for LawEffect {
         }
         let curve = match self.law.table() {
             Some(t) => Some(Arc::new(
-                t.curve(n.rs_ohm, n.lls_h, n.v_phase_peak * 1.5f64.sqrt(), n.f_hz)
+                t.curve(n.rs_ohm, 0.0, n.v_phase_peak * 1.5f64.sqrt(), n.f_hz)
                     .map_err(|_| {
                         SetupError::NothingToFit(
                             "the no-load table does not fit the parameter file's machine",
@@ -293,6 +297,9 @@ impl LawOnLog {
     /// Lm over the file's at each sample's measured magnetising current (the reduced
     /// model's scale), and the law's shape for the full-order model.
     fn magnetising(&self, values: &[f64], d: &Prepared, n: &MachineConstants, t: &mut ModelTerms) {
+        // A no-load curve is Ls of the stator flux: Lm is Ls less the file's stator leakage.
+        let stator = self.curve.is_some();
+        let lls = if stator { n.lls_h } else { 0.0 };
         let lm0 = self.lm_at(values, 0.0);
         let lm = |psi: f64| self.lm_at(values, psi);
         let i_max = 1.05 * d.i_f.iter().fold(0.0f64, |a, i| a.max(i.abs())) + 1e-9;
@@ -313,7 +320,7 @@ impl LawOnLog {
                 a + (b - a) * f
             }
         };
-        t.scale_magnetising_inductance(d.i_f.iter().map(|&i| at(i) / n.lm_h));
+        t.scale_magnetising_inductance(d.i_f.iter().map(|&i| (at(i) - lls).max(1e-9) / n.lm_h));
         let (law, curve, values) = (Arc::clone(&self.law), self.curve.clone(), values.to_vec());
         let shape = move |psi: f64| {
             let l = match &curve {
@@ -330,7 +337,8 @@ impl LawOnLog {
         };
         t.magnetising.law = Some(MagnetisingLaw::Shape(LmShape {
             shape: Arc::new(shape),
-            lm0_over_file: lm0 / n.lm_h,
+            lm0_over_file: (lm0 - lls).max(1e-9) / n.lm_h,
+            stator,
         }));
     }
 }
@@ -428,9 +436,9 @@ impl Contribution for LawOnLog {
             })
             .collect();
         if values.is_empty() {
-            format!("{} ({})", self.law.id, self.law.acts_on)
+            format!("the law of {} as given", self.law.acts_on)
         } else {
-            format!("{}: {}", self.law.id, values.join(", "))
+            values.join(", ")
         }
     }
 }

@@ -82,6 +82,10 @@ struct SatMachine<'a> {
     /// A user's law's shape `Lm(psi_m) / Lm(0)` in place of the power law
     /// ([`MagnetisingLaw::Shape`]).
     shape: Option<&'a LmShape>,
+    /// With a stator-flux law ([`LmShape::stator`]): the Gamma-equivalent circuit, whose
+    /// stator inductance Ls0 (unsaturated) is `1/inv_lm0` and whose rotor leakage is
+    /// `1/inv_llr` (no stator leakage).
+    gamma: bool,
     /// The last solve's 1/Lm (0: none yet).
     guess: &'a std::cell::Cell<f64>,
 }
@@ -106,16 +110,24 @@ impl<'a> SatMachine<'a> {
         };
         let sigma_n = n.lls_h + n.lm_h * n.llr_h / (n.llr_h + n.lm_h);
         let scale = m.l_sigma / sigma_n.max(1e-12);
-        let (lls, llr) = (n.lls_h * scale, n.llr_h * scale);
+        let gamma = shape.is_some_and(|s| s.stator);
+        // The Gamma circuit of the same machine: Ls = L_sigma + L_M, its rotor leakage
+        // Ls L_sigma / L_M (the transient inductance L_sigma kept).
+        let (lls, llr) = if gamma {
+            (0.0, m.l_sigma * (m.l_sigma + m.l_m) / m.l_m.max(1e-12))
+        } else {
+            (n.lls_h * scale, n.llr_h * scale)
+        };
         let lm0 = (m.l_sigma + m.l_m - lls).max(1e-6);
         SatMachine {
-            inv_lls: 1.0 / lls.max(1e-9),
+            inv_lls: if gamma { 0.0 } else { 1.0 / lls.max(1e-9) },
             inv_llr: 1.0 / llr.max(1e-9),
             inv_lm0: 1.0 / lm0,
             rr: m.a * (llr + lm0),
             psi_sat: power.psi_sat_wb.max(1e-9),
             nexp: power.exponent,
             shape,
+            gamma,
             guess,
         }
     }
@@ -133,6 +145,13 @@ impl<'a> SatMachine<'a> {
     /// Stator and rotor currents at the fluxes `ps`, `pr`.
     #[inline(always)]
     fn currents(&self, ps: C64, pr: C64) -> (C64, C64) {
+        if let (true, Some(s)) = (self.gamma, self.shape) {
+            // Gamma: psi_s = Ls(|psi_s|) (i_s + i_R), psi_R = psi_s + L_sR i_R.
+            let sh = (s.shape)(ps.norm());
+            let sh = if sh.is_finite() && sh > 0.0 { sh } else { 1.0 };
+            let i_r = (pr - ps) * self.inv_llr;
+            return (ps * (self.inv_lm0 / sh) - i_r, i_r);
+        }
         let w = ps * self.inv_lls + pr * self.inv_llr;
         let g = self.inv_lls + self.inv_llr;
         if let Some(s) = self.shape {

@@ -100,11 +100,15 @@ impl MagnetisingLaw {
 /// A user's magnetising law as a shape ([`MagnetisingLaw::Shape`]).
 #[derive(Clone)]
 pub struct LmShape {
-    /// `Lm(psi_m) / Lm(0)` at the flux `psi_m` [Wb, peak] (finite and positive where the
-    /// law is physical).
+    /// `L(psi) / L(0)` at the flux `psi` [Wb, peak] (finite and positive where the law is
+    /// physical): Lm of the magnetising flux, or with `stator` Ls of the stator flux.
     pub shape: Arc<dyn Fn(f64) -> f64 + Send + Sync>,
-    /// `Lm(0)` over the file's `lm_h`.
+    /// The unsaturated Lm over the file's `lm_h` (with `stator`: `Ls(0) - Lls` over it).
     pub lm0_over_file: f64,
+    /// The law is the stator inductance Ls of the stator flux (a no-load test's curve, the
+    /// Gamma-equivalent circuit: no stator leakage, the machine's leakage on the rotor
+    /// side), not Lm of the magnetising flux of the file's T-equivalent circuit.
+    pub stator: bool,
 }
 
 impl std::fmt::Debug for LmShape {
