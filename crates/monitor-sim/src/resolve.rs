@@ -121,8 +121,8 @@ impl ResolvedEffects {
                         None => MagLaw::Law(b.clone()),
                         Some(t) => {
                             // The stator inductance of the stator flux (no leakage taken
-                                // off): the machine runs as its Gamma circuit.
-                                let curve = t
+                            // off): the machine runs as its Gamma circuit.
+                            let curve = t
                                 .curve(
                                     m.rs_ohm,
                                     0.0,

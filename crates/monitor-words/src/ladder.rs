@@ -7,8 +7,8 @@ use crate::analysis::{effect_names, skipped};
 use crate::Spelling;
 use monitor_analysis::effects::{sig, ALPHA_CU_PER_K};
 use monitor_analysis::explain::ladder::{
-    BaseChange, FinalFit, LadderReport, LadderStep, Refusal, StopReason, TestRule, Tried,
-    WhatIsLeft, WhyNotPhysical,
+    BaseChange, FinalFit, LadderReport, LadderStep, NotSeparable, Refusal, StopReason, TestRule,
+    Tried, WhatIsLeft, WhyNotPhysical,
 };
 use monitor_analysis::fit::machine::BaseKey;
 use serde_json::Value;
@@ -294,7 +294,7 @@ fn found(r: &LadderReport, f: &FinalFit) -> Vec<String> {
     for e in f
         .fitted
         .iter()
-        .filter(|e| !e.effect.name().ends_with("_dynamics") && !r.start.effects.contains(&e.effect))
+        .filter(|e| !e.effect.is_dynamics() && !r.start.effects.contains(&e.effect))
     {
         found.push(format!("{}: {}", e.effect, e.summary));
     }
@@ -344,9 +344,14 @@ pub fn base_changes(c: &[BaseChange]) -> String {
         .filter(|x| !x.identified)
         .map(|x| x.base.symbol())
         .collect();
+    for x in c {
+        if let Some(n) = &x.not_separable {
+            parts.push(not_separable(x, n));
+        }
+    }
     let unchanged: Vec<&str> = c
         .iter()
-        .filter(|x| x.identified && !x.changed)
+        .filter(|x| x.identified && !x.changed && x.not_separable.is_none())
         .filter(|x| !matches!(x.base, BaseKey::Rs | BaseKey::Rr) || parts.is_empty())
         .map(|x| x.base.symbol())
         .collect();
@@ -363,6 +368,29 @@ pub fn base_changes(c: &[BaseChange]) -> String {
         ));
     }
     parts.join("; ")
+}
+
+/// `B + Bl +89 % (±15 %) is not separable from compressor on this log: without it the model
+/// still reaches 1.01x its noise floor`: a change the fit reads that only trades with the
+/// effects' values (or the other base parameters), no finding.
+fn not_separable(x: &BaseChange, n: &NotSeparable) -> String {
+    let from = if n.traded_with.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " from {}",
+            n.traded_with
+                .iter()
+                .map(|e| e.name())
+                .collect::<Vec<_>>()
+                .join(" and ")
+        )
+    };
+    format!(
+        "{} is not separable{from} on this log: without it the model still reaches {:.2}x its noise floor",
+        base_change(x),
+        n.ratio_without
+    )
 }
 
 /// The likely reading of a change of each base parameter other than the resistances.

@@ -376,6 +376,26 @@ pub fn fit_machine(
     prior_weight: f64,
     max_iter: usize,
 ) -> Result<MachineFit, EffectValuesError> {
+    fit_machine_pinned(d, file, effects, w, start, prior_weight, max_iter, None)
+}
+
+/// [`fit_machine`] with the base parameter `pin` (if any) held at the file's value: the
+/// fit of the same model without that change, for what the others and the effects' values
+/// make of the log then.
+///
+/// # Errors
+/// As [`fit_machine`].
+#[allow(clippy::too_many_arguments)]
+pub fn fit_machine_pinned(
+    d: &Prepared,
+    file: &ParamFile,
+    effects: &[ActiveEffect<'_>],
+    w: &Weights,
+    start: &MachineScales,
+    prior_weight: f64,
+    max_iter: usize,
+    pin: Option<BaseKey>,
+) -> Result<MachineFit, EffectValuesError> {
     let prob = problem(d, file, effects, w, prior_weight);
     let bs = prob.b_sd / PRIOR_SD[5];
     let mut x = start.to_vec();
@@ -390,8 +410,12 @@ pub fn fit_machine(
         hi.push(q.hi);
         scale.push(q.scale);
     }
+    if let Some(k) = pin {
+        x[k.index()] = MachineScales::of_file(file).get(k);
+    }
     prob.machine(&x)?;
-    let free = prob.free(x.len());
+    let mut free = prob.free(x.len());
+    free.retain(|&i| pin.is_none_or(|k| i != k.index()));
     let bounds = lm::Bounds { lo, hi, scale };
     let (x, report) = lm::solve(&prob, x, &bounds, &free, max_iter);
     Ok(MachineFit {

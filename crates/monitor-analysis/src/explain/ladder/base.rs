@@ -38,8 +38,30 @@ pub struct BaseChange {
     /// True when the log determines the value within ±[`UNIDENTIFIED_SD`].
     pub identified: bool,
     /// True when the change is one the ladder names: identified, at least
-    /// [`BASE_CHANGE_MIN`], and its interval excludes no change.
+    /// [`BASE_CHANGE_MIN`], its interval excludes no change, and it is the log's own
+    /// evidence (not [`BaseChange::not_separable`]).
     pub changed: bool,
+    /// The change the fit reads, but the same model without it still explains the log
+    /// (the ladder's end, `Ladder::final_fit`): it trades with the effects' values on this
+    /// log and is no finding.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub not_separable: Option<NotSeparable>,
+}
+
+/// A base change the log cannot tell from the effects' values (JSON
+/// `base_changes[].not_separable`, `final_fit.base[].not_separable`): the chosen model
+/// refitted with the parameter at the file's value.
+#[derive(Debug, Clone, Serialize)]
+pub struct NotSeparable {
+    /// The whole-log error without the change.
+    pub error_without: f64,
+    /// Its ratio to the noise floor.
+    pub ratio_without: f64,
+    /// The share of the error beyond the floor the change removes.
+    pub removes: f64,
+    /// The effects whose values took the change up (by more than 0.5 %; empty: none did,
+    /// the other base parameters or nothing carry it).
+    pub traded_with: Vec<monitor_laws::EffectId>,
 }
 
 /// The file's value of `key` and its unit.
@@ -90,6 +112,7 @@ pub fn base_changes(
                 unit,
                 identified,
                 changed: identified && excludes_zero && change.abs() >= BASE_CHANGE_MIN,
+                not_separable: None,
             }
         })
         .collect()

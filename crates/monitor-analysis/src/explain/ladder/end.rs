@@ -9,12 +9,12 @@
 //! as `compare`'s), from the last step's values, with the six base parameters free
 //! ([`crate::fit::machine`]): the base changes are read there, with their intervals.
 
-use super::base::{base_changes, prior_weight, BaseChange};
+use super::base::{base_changes, prior_weight, BaseChange, NotSeparable};
 use super::climb::Ladder;
 use super::rung::{nested_from, setup_list};
 use crate::analysis::{align, Analysis, AnalysisError, FittedEffect, MAX_ITER};
 use crate::effects::EffectModel;
-use crate::fit::machine::{self, MachineFit};
+use crate::fit::machine::{self, BaseKey, MachineFit};
 use crate::fit::{ActiveEffect, BaseSpec, FitResult};
 use crate::metrics::{self, Weights};
 use crate::prep::Prepared;
@@ -58,6 +58,33 @@ impl Ladder<'_> {
             return Ok(None);
         };
         let (mf, half) = self.machine_on(&an, &fdata, &set)?;
+        let (error, noise, fitted) = self.on_whole_log(&mf)?;
+        let mut base = base_changes(&mf.scales, &sr.file, &half);
+        if sr.fit_base {
+            for c in base.iter_mut().filter(|c| c.changed) {
+                c.not_separable = self.without_change(&fdata, &set, &mf, c.base, error, noise)?;
+                c.changed = c.not_separable.is_none();
+            }
+        }
+        Ok(Some(FinalFit {
+            effects: rung.kinds.clone(),
+            error,
+            noise_floor: noise,
+            ratio_to_floor: error / noise,
+            below_start: start_error / error,
+            base,
+            fitted,
+            fit_samples: fdata.len(),
+        }))
+    }
+
+    /// The chosen model at the machine fit `mf` on the whole working series: its error,
+    /// its noise floor and its effects' values.
+    fn on_whole_log(
+        &self,
+        mf: &MachineFit,
+    ) -> Result<(f64, f64, Vec<FittedEffect>), AnalysisError> {
+        let (file, rung, sr) = (self.file, &self.rung, &self.series);
         let fin = file.rebased(mf.params(&sr.file));
         let models: Vec<&dyn EffectModel> = rung.models.clone();
         let active = setup_list(&fin, &file.data, &models)?;
@@ -73,16 +100,58 @@ impl Ladder<'_> {
         let all = Weights::new(&file.data, 0, usize::MAX);
         let noise = metrics::noise_floor(&file.data, &all, Some((&pred, &renoised)));
         let error = metrics::errors(&file.data, &pred, None).normalized_rms_error;
-        let fitted = fin.fitted_effects(&active, &fit)?;
-        Ok(Some(FinalFit {
-            effects: rung.kinds.clone(),
-            error,
-            noise_floor: noise,
-            ratio_to_floor: error / noise,
-            below_start: start_error / error,
-            base: base_changes(&mf.scales, &sr.file, &half),
-            fitted,
-            fit_samples: fdata.len(),
+        Ok((error, noise, fin.fitted_effects(&active, &fit)?))
+    }
+
+    /// Whether the change of `key` the fit `mf` reads (whole-log error `error`, floor
+    /// `noise`) is the log's own evidence: the same model refitted with `key` held at the
+    /// file's value. Where that model still explains the log within the noise-floor band
+    /// ([`super::FLOOR_BAND`]), the change only trades with the effects' values (or the
+    /// other base parameters): it is not separable on this log ([`NotSeparable`]), not a
+    /// finding. (A model above the band keeps its changes: the error the effects leave is
+    /// not the change's to carry, and a small true change removes little of it.)
+    fn without_change(
+        &self,
+        fdata: &Prepared,
+        set: &[ActiveEffect<'_>],
+        mf: &MachineFit,
+        key: BaseKey,
+        error: f64,
+        noise: f64,
+    ) -> Result<Option<NotSeparable>, AnalysisError> {
+        let (rung, sr) = (&self.rung, &self.series);
+        let w = Weights::new(fdata, 0, usize::MAX);
+        let pinned = machine::fit_machine_pinned(
+            fdata,
+            &sr.file,
+            set,
+            &w,
+            &mf.scales,
+            prior_weight(rung.noise),
+            MAX_ITER,
+            Some(key),
+        )?;
+        let (e_pin, _, _) = self.on_whole_log(&pinned)?;
+        let removes = if e_pin > noise {
+            (e_pin - error) / (e_pin - noise)
+        } else {
+            0.0
+        };
+        if e_pin / noise > super::FLOOR_BAND {
+            return Ok(None);
+        }
+        let traded_with = rung
+            .models
+            .iter()
+            .zip(mf.effect_params.iter().zip(&pinned.effect_params))
+            .filter(|(_, (a, b))| moved(a, b))
+            .map(|(m, _)| m.kind())
+            .collect();
+        Ok(Some(NotSeparable {
+            error_without: e_pin,
+            ratio_without: e_pin / noise,
+            removes,
+            traded_with,
         }))
     }
 
@@ -126,4 +195,12 @@ impl Ladder<'_> {
         };
         Ok((mf, [None; 6]))
     }
+}
+
+/// True when an effect's values `a` and `b` differ by more than 0.5 % of the larger (a
+/// value that carries what the pinned base parameter did).
+fn moved(a: &[f64], b: &[f64]) -> bool {
+    a.iter()
+        .zip(b)
+        .any(|(x, y)| (x - y).abs() > 0.005 * x.abs().max(y.abs()).max(1e-12))
 }

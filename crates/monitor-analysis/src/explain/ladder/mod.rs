@@ -52,7 +52,7 @@ mod stepwise;
 #[cfg(test)]
 mod tests;
 
-pub use base::{base_changes, BaseChange, BASE_CHANGE_MIN};
+pub use base::{base_changes, BaseChange, NotSeparable, BASE_CHANGE_MIN};
 pub use end::FinalFit;
 pub use refusal::{Refusal, StopReason, WhatIsLeft, WhyNotPhysical};
 pub use split::stratified_heldback;
