@@ -111,6 +111,7 @@ fn run(path: &std::path::Path, p: ParamFile, format: &str) {
     let opts = Options {
         effects: vec![],
         fit_base: true,
+        laws: Default::default(),
     };
     let t1 = Instant::now();
     let c = a.compare(&opts).expect("compare");

@@ -78,6 +78,7 @@ fn main() {
         let opts = Options {
             effects: vec![],
             fit_base: true,
+            laws: Default::default(),
         };
         let r = a.ladder(&opts, &|_, _| {}).expect("ladder");
         let wall = t0.elapsed().as_secs_f64();

@@ -3,6 +3,7 @@
 mod analysis_common;
 use analysis_common::*;
 use assert_cmd::Command;
+use monitor_analysis::EffectId;
 
 fn run(args: &[&str], params: &std::path::Path, log: &std::path::Path) -> Vec<u8> {
     Command::cargo_bin("sim-host")

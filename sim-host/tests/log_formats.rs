@@ -137,6 +137,7 @@ fn every_format_gives_the_same_rows_verdicts_and_figures() {
             .compare(&Options {
                 effects: vec![],
                 fit_base: true,
+                laws: Default::default(),
             })
             .expect("compare");
         (json_without(f, &out.report), json_without(f, &a.quality))

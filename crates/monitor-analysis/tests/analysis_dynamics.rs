@@ -218,7 +218,7 @@ fn locked_rotor_torque(p: &ParamFile) -> f64 {
 fn hidden_case(
     dir: &std::path::Path,
     which: &str,
-    kind: EffectId,
+    kind: monitor_core::EffectKind,
     rate_hz: f64,
 ) -> (String, f64, bool, f64, f64, f64) {
     let truth = params(which);
@@ -229,7 +229,7 @@ fn hidden_case(
         // speed, about rated) is more than the 11 kW machine's locked-rotor torque (a
         // single-cage model has no deep-bar rise of Rr at standstill), and that active load
         // drives it backwards from the start; there half of it.
-        EffectId::LOAD_TORQUE => {
+        monitor_core::EffectKind::LoadTorque => {
             let default = truth.motor.bl_nms * sync_speed_mech(&truth);
             monitor_sim::EffectSpec::LoadTorque {
                 torque_nm: (default > locked_rotor_torque(&truth)).then_some(0.5 * default),
@@ -287,16 +287,16 @@ fn hidden_case(
 /// noise in this log (the error without them is already within 2x the floor), so
 /// `explain` may rightly claim nothing.
 fn hidden_effects_found_at(rate_hz: f64) {
-    use EffectId;
+    use monitor_core::EffectKind;
     let dir = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
     let found = [
-        EffectId::LOAD_TORQUE,
-        EffectId::SUPPLY_UNBALANCE,
-        EffectId::THERMAL_DRIFT,
-        EffectId::SATURATION,
-        EffectId::PHASE_ASYMMETRY,
-        EffectId::ROTOR_ASYMMETRY,
+        EffectKind::LoadTorque,
+        EffectKind::SupplyUnbalance,
+        EffectKind::ThermalDrift,
+        EffectKind::Saturation,
+        EffectKind::PhaseAsymmetry,
+        EffectKind::RotorAsymmetry,
     ];
     let cases = sweep(
         &format!("hidden effects at {rate_hz} Hz"),
@@ -325,8 +325,8 @@ fn hidden_effects_found_at(rate_hz: f64) {
 
 /// The hidden-effect cases of the default run: each effect once, each motor and each rate
 /// twice.
-fn in_default_hidden(which: &str, kind: EffectId, rate_hz: f64) -> bool {
-    use EffectId as K;
+fn in_default_hidden(which: &str, kind: monitor_core::EffectKind, rate_hz: f64) -> bool {
+    use monitor_core::EffectKind as K;
     let (w, r) = match kind {
         K::LoadTorque => ("2p2", 2000.0),
         K::Saturation => ("3hp", 2000.0),
@@ -440,7 +440,9 @@ fn saturated_full_order_model_reproduces_the_simulator() {
         let m = p.motor.model::<f64>();
         let mut s = transients(which, 5000.0);
         s.sensors = monitor_sim::SensorSpec::ideal();
-        s.effects = vec![monitor_sim::EffectSpec::with_defaults(EffectId::SATURATION)];
+        s.effects = vec![monitor_sim::EffectSpec::with_defaults(
+            monitor_core::EffectKind::Saturation,
+        )];
         let log = write_log(dir.path(), &format!("sat_{which}"), &p, &s, false);
         let a = analyse(&log, &p, 0.0);
         let psi_sat = 1.3 * p.supply.v_phase_peak() / p.supply.omega_rad_s();
@@ -449,10 +451,12 @@ fn saturated_full_order_model_reproduces_the_simulator() {
             let terms = sm::ModelTerms {
                 dynamics: full_order_dynamics(&m),
                 magnetising: sm::Magnetising {
-                    law: sat.map(|(psi_sat_wb, exponent)| sm::SaturationLaw {
-                        psi_sat_wb,
-                        exponent,
-                        lm0_over_file: a.constants.lm0_over_file(psi_sat_wb, exponent),
+                    law: sat.map(|(psi_sat_wb, exponent)| {
+                        sm::MagnetisingLaw::Power(sm::SaturationLaw {
+                            psi_sat_wb,
+                            exponent,
+                            lm0_over_file: a.constants.lm0_over_file(psi_sat_wb, exponent),
+                        })
                     }),
                     ..Default::default()
                 },

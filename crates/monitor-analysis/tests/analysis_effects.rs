@@ -15,7 +15,7 @@
 //! effect-free log (`analysis_common`'s module doc; `.ci/run` runs it).
 mod analysis_common;
 use analysis_common::*;
-use monitor_laws::EffectId;
+use monitor_core::EffectKind;
 use monitor_sim::EffectSpec;
 
 const DYNAMICS: [&str; 2] = ["flux_dynamics", "current_dynamics"];
@@ -34,7 +34,7 @@ fn check_all(config: usize) {
         .filter(|k| {
             !matches!(
                 k,
-                EffectId::D_AXIS_DYNAMICS | EffectId::CROSS_COUPLING_DYNAMICS
+                EffectKind::DAxisDynamics | EffectKind::CrossCouplingDynamics
             )
         })
         .map(|k| k.name())
@@ -219,7 +219,7 @@ fn motulator_log_points_at_load_torque() {
     eprintln!("{:?}", ex.conclusion);
     assert_eq!(
         ex.ranking[0].effect,
-        EffectId::LOAD_TORQUE,
+        EffectKind::LoadTorque,
         "{:?}",
         ex.conclusion
     );
@@ -251,7 +251,7 @@ fn dynamics_effects_need_an_input_transient() {
         let a = analyse(&log, &nominal, from_for("3hp", name));
         let ex = a.explain(&opts(base), &|_| {}).unwrap().report;
         let skipped = ex.skipped.iter().any(|m| {
-            m.effect == EffectId::D_AXIS_DYNAMICS
+            m.effect == EffectKind::DAxisDynamics
                 && matches!(
                     m.because,
                     monitor_analysis::explain::SkipReason::NotProposed {
@@ -262,7 +262,7 @@ fn dynamics_effects_need_an_input_transient() {
         let ranked = ex
             .ranking
             .iter()
-            .any(|c| c.effect == EffectId::D_AXIS_DYNAMICS);
+            .any(|c| c.effect == EffectKind::DAxisDynamics);
         assert_eq!(skipped, expect_skipped, "{name}: {:?}", ex.skipped);
         assert_eq!(ranked, !expect_skipped, "{name}: {:?}", ex.ranking);
     }

@@ -9,7 +9,8 @@ use monitor_analysis::explain::{ExplainReport, Standing, EXPLAINS_MIN};
 use monitor_analysis::simplified_model::BaseParameter;
 use monitor_analysis::transients::{Advice, Cover, NotProposed};
 use monitor_analysis::unbalance::UnbalanceFinding;
-use monitor_laws::EffectId;
+use monitor_analysis::EffectId;
+use monitor_core::EffectKind;
 use monitor_sim::{LoadKind, LoadSpec, LoadStep, Scenario, SupplyStep};
 
 /// A direct-on-line start from standstill, then steady running: 3 s at 5 kHz.
@@ -35,7 +36,8 @@ fn a_start_is_named_with_the_dynamics_effects_and_a_from() {
     );
     let added = proposed(&c.advice);
     assert!(
-        added.contains(&EffectId::FLUX_DYNAMICS) && added.contains(&EffectId::CURRENT_DYNAMICS),
+        added.contains(&EffectKind::FluxDynamics.into())
+            && added.contains(&EffectKind::CurrentDynamics.into()),
         "{:?}",
         c.advice
     );

@@ -106,7 +106,7 @@ fn a_count_that_does_not_match_is_an_error_not_a_dropped_effect() {
     assert_eq!(
         err,
         EffectValuesError::Count {
-            effect: EffectId::WINDAGE,
+            effect: monitor_core::EffectKind::Windage.into(),
             expected: 1,
             got: 2
         }
@@ -120,7 +120,8 @@ fn a_count_that_does_not_match_is_an_error_not_a_dropped_effect() {
     // The set-up refuses it too, where the model is built from fitted values.
     let n = MachineConstants::from_params(&ParamFile::reference_2p2kw());
     let d = Prepared::default();
-    let setup = model_of(EffectId::WINDAGE)
+    let setup = model_of(monitor_core::EffectKind::Windage)
+        .expect("a library effect")
         .setup(&d, &n)
         .expect("windage sets up on any log");
     let mut terms = Default::default();

@@ -6,7 +6,7 @@ mod analysis_common;
 use analysis_common::*;
 use monitor_analysis::effects::{load_segments, model_of, LoadSegment};
 use monitor_analysis::{Analysis, FittedEffect};
-use monitor_laws::EffectId;
+use monitor_core::EffectKind;
 use monitor_sim::{LoadKind, LoadSpec, LoadStep, Scenario};
 
 /// The four dynamics effects: the full-order machine.
@@ -29,7 +29,7 @@ fn with_load() -> Vec<&'static str> {
 fn levels(f: &[FittedEffect]) -> Vec<f64> {
     let lt = f
         .iter()
-        .find(|e| e.effect == EffectId::LOAD_TORQUE)
+        .find(|e| e.effect == EffectKind::LoadTorque)
         .expect("load_torque fitted");
     let mut v: Vec<(usize, f64)> = lt
         .parameters
@@ -136,7 +136,8 @@ fn steps_off_any_grid_are_found_to_the_sample() {
     let (_dir0, log0) = project_log(&[]);
     let a0 = analyse(&log0, &truth, f64::NEG_INFINITY);
     assert_eq!(segments(&a0).len(), 1, "{:?}", segments(&a0));
-    let setup = model_of(EffectId::LOAD_TORQUE)
+    let setup = model_of(EffectKind::LoadTorque)
+        .expect("a library effect")
         .setup(&a0.data, &a0.constants)
         .unwrap();
     assert_eq!(setup.len(), 1, "{:?}", setup.params);

@@ -12,8 +12,8 @@ mod analysis_common;
 use analysis_common::*;
 use monitor_analysis::refit::BaseRefit;
 use monitor_analysis::simplified_model::BaseParameter;
+use monitor_core::EffectKind;
 use monitor_io::params::ParamFile;
-use monitor_laws::EffectId;
 
 /// The model the protocol starts from (a full-order simulator always has these).
 const DYNAMICS: [&str; 2] = ["flux_dynamics", "current_dynamics"];
@@ -156,10 +156,10 @@ fn two_parameters_20_percent_off_still_name_the_hidden_effect() {
         .filter(|k| {
             !matches!(
                 k,
-                EffectId::D_AXIS_DYNAMICS
-                    | EffectId::CROSS_COUPLING_DYNAMICS
-                    | EffectId::FLUX_DYNAMICS
-                    | EffectId::CURRENT_DYNAMICS
+                EffectKind::DAxisDynamics
+                    | EffectKind::CrossCouplingDynamics
+                    | EffectKind::FluxDynamics
+                    | EffectKind::CurrentDynamics
             )
         })
         .map(|k| k.name())

@@ -17,8 +17,8 @@ use analysis_common::{
     analyse, in_this_run, loaded_start, motor, opts, settle_s, sweep, write_log,
 };
 use monitor_analysis::rotor_asymmetry::{mcsa, McsaReport};
+use monitor_core::EffectKind;
 use monitor_io::params::ParamFile;
-use monitor_laws::EffectId;
 use monitor_sim::{self as sim, EffectSpec, Scenario, Truth};
 use std::f64::consts::PI;
 
@@ -155,7 +155,7 @@ fn broken_bars_give_delta_in_scenarios() {
         .unwrap_err()
         .to_string()
         .contains("broken_bars"));
-    assert!(EffectSpec::with_defaults(EffectId::ROTOR_ASYMMETRY)
+    assert!(EffectSpec::with_defaults(EffectKind::RotorAsymmetry)
         .validate()
         .is_ok());
 }
@@ -197,7 +197,7 @@ fn analyse_case(which: &str, load: f64, delta: f64) -> (String, bool, f64, f64, 
     let fitted = r
         .ranking
         .iter()
-        .find(|c| c.effect == EffectId::ROTOR_ASYMMETRY)
+        .find(|c| c.effect == EffectKind::RotorAsymmetry)
         .and_then(|c| c.parameters.get("delta"))
         .map(|v| v.value);
     let m = mcsa(&a.data, a.constants.np, Some(28.0), fitted);

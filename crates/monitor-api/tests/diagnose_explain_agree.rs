@@ -157,14 +157,14 @@ fn a_healthy_motor_on_vf_steps_claims_no_effect() {
     let dir = tempfile::tempdir().expect("temp dir");
     let log = dir.path().join("vf.csv");
     api::simulate_to_file(source(), scenario, &log).expect("simulates");
-    let dynamics: Vec<EffectId> = [
+    let dynamics: Vec<String> = [
         "flux_dynamics",
         "current_dynamics",
         "d_axis_dynamics",
         "cross_coupling_dynamics",
     ]
     .iter()
-    .map(|n| monitor_core::EffectKind::from_name(n).expect("an effect"))
+    .map(|n| n.to_string())
     .collect();
     for from_s in [None, Some(0.3)] {
         let req = AnalysisRequest {

@@ -25,9 +25,10 @@ use syn::spanned::Spanned;
 use syn::visit::Visit;
 
 /// The engine crates: they return typed values, never a front end's words.
-const ENGINES: [&str; 7] = [
+const ENGINES: [&str; 8] = [
     "crates/monitor-core/src/",
     "crates/monitor-io/src/",
+    "crates/monitor-laws/src/",
     "crates/monitor-sim/src/",
     "crates/monitor-replay/src/",
     "crates/monitor-analysis/src/",

@@ -22,8 +22,9 @@ pub fn opts(effects: &[&str]) -> Options {
     Options {
         effects: effects
             .iter()
-            .map(|s| EffectKind::from_name(s).expect("library name"))
+            .map(|s| EffectKind::from_name(s).expect("library name").into())
             .collect(),
         fit_base: true,
+        laws: Default::default(),
     }
 }

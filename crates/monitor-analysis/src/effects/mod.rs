@@ -353,7 +353,8 @@ fn library_with(thermal: ThermalDrift) -> Vec<Box<dyn EffectModel>> {
 
 /// The model of an effect of the library (`None` for a name the library does not have: a
 /// user's law is found in a [`Registry`]).
-pub fn model_of(id: EffectId) -> Option<Box<dyn EffectModel>> {
+pub fn model_of(id: impl Into<EffectId>) -> Option<Box<dyn EffectModel>> {
+    let id = id.into();
     library().into_iter().find(|m| m.kind() == id)
 }
 
@@ -517,7 +518,7 @@ mod tests {
     #[test]
     fn every_effect_kind_has_its_model() {
         for kind in EffectKind::ALL {
-            assert_eq!(model_of(kind.into()).map(|m| m.kind()), Some(kind.into()));
+            assert_eq!(model_of(kind).map(|m| m.kind()), Some(EffectId::from(kind)));
         }
         assert_eq!(library().len(), EffectKind::ALL.len());
     }

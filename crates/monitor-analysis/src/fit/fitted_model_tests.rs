@@ -8,7 +8,7 @@ use monitor_laws::EffectId;
 fn a_fitted_model_says_what_it_is() {
     let n = MachineConstants::from_params(&monitor_io::params::ParamFile::reference_2p2kw());
     let d = Prepared::default();
-    let cd = model_of(EffectId::CURRENT_DYNAMICS);
+    let cd = model_of(EffectId::CURRENT_DYNAMICS).expect("a library effect");
     let setup = cd.setup(&d, &n).unwrap();
     let m = FittedModel {
         effects: vec![ActiveEffect {

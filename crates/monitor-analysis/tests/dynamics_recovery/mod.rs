@@ -11,8 +11,8 @@ const LOG_S: f64 = 3.4;
 /// tolerance)` of the analysis' fitted parameter; `None` for parameters whose analysis form
 /// is not the simulator's (the winding asymmetry's `c` is the negative-sequence current
 /// ratio it makes, judged by its phase below).
-fn injected(kind: EffectId, p: &ParamFile) -> Vec<(&'static str, f64, f64)> {
-    use EffectId as K;
+fn injected(kind: monitor_core::EffectKind, p: &ParamFile) -> Vec<(&'static str, f64, f64)> {
+    use monitor_core::EffectKind as K;
     let we = 2.0 * std::f64::consts::PI * p.supply.f_hz;
     // The simulator's "rated torque estimate": the viscous load's torque at synchronous speed.
     let t_rated = p.motor.bl_nms * sync_speed_mech(p);
@@ -52,7 +52,7 @@ fn injected(kind: EffectId, p: &ParamFile) -> Vec<(&'static str, f64, f64)> {
 /// 0.9973-1.000; delta 0.9989-1.0061.
 #[test]
 fn effect_parameters_are_recovered_through_transients() {
-    use EffectId as K;
+    use monitor_core::EffectKind as K;
     let dir = tempfile::tempdir().unwrap();
     let mut failures = Vec::new();
     let kinds: Vec<K> = K::ALL.into_iter().filter(|k| !k.is_dynamics()).collect();

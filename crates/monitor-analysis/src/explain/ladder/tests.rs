@@ -47,9 +47,11 @@ fn ladder_on<'a>(
     let opts = Options {
         effects: configured.to_vec(),
         fit_base: true,
+        laws: Default::default(),
     };
     // (The configured effects' models live as long as the ladder: leaked, in a test.)
-    let boxes: &'a [Box<dyn EffectModel>] = Box::leak(resolve(configured).into_boxed_slice());
+    let boxes: &'a [Box<dyn EffectModel>] =
+        Box::leak(resolve(configured, &Default::default()).into_boxed_slice());
     Ladder::start(a, lib, boxes, &opts, held, &NO_PROGRESS).expect("start")
 }
 
@@ -93,7 +95,7 @@ fn rung_of<'a>(
 fn a_stand_in_a_later_step_explains_is_dropped() {
     let dir = tempfile::tempdir().expect("tempdir");
     let a = fan_log(dir.path());
-    let lib = effects::ladder_library();
+    let lib = crate::effects::ladder_library();
     let ladder = ladder_on(&a, &lib, &[]);
     let sr = &ladder.series;
     let full = [
@@ -150,7 +152,7 @@ fn a_stand_in_a_later_step_explains_is_dropped() {
 fn what_the_user_configured_and_the_machine_order_stay() {
     let dir = tempfile::tempdir().expect("tempdir");
     let a = fan_log(dir.path());
-    let lib = effects::ladder_library();
+    let lib = crate::effects::ladder_library();
     let ladder = ladder_on(&a, &lib, &[EffectId::IRON_LOSS]);
     let sr = &ladder.series;
     let kinds = [
