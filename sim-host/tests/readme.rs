@@ -255,7 +255,11 @@ fn the_readme_walkthroughs_print_what_the_readme_shows() {
 #[test]
 fn the_docs_walkthroughs_print_what_the_docs_show() {
     let mut n = 0;
-    for page in ["docs/model-vs-measurement.md", "docs/own-motor.md"] {
+    for page in [
+        "docs/model-vs-measurement.md",
+        "docs/own-motor.md",
+        "docs/your-own-law.md",
+    ] {
         n += check(page);
     }
     assert!(n >= 5, "only {n} walkthroughs found in docs/");

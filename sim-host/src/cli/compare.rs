@@ -189,8 +189,9 @@ pub struct CompareArgs {
     long_about = "Rank the physical effects missing from the paper's simplified model.\n\n\
 Every library effect not yet in the model (thermal_drift, saturation, iron_loss, \
 coulomb_friction, windage, load_torque, supply_unbalance, phase_asymmetry, flux_dynamics, \
-current_dynamics, d_axis_dynamics, cross_coupling_dynamics, rotor_asymmetry) is added in turn \
-and fitted together with the base parameters (Ra, Ls, B+Bl, J). The dynamics effects (those \
+current_dynamics, d_axis_dynamics, cross_coupling_dynamics, rotor_asymmetry), and each law of \
+your own with --laws FILE (docs/your-own-law.md), is added in turn and fitted together with \
+the base parameters (Ra, Ls, B+Bl, J). The dynamics effects (those \
 with a time constant) are proposed only when the analysed span holds a start or a supply \
 step; with all four the model is the full-order machine. Candidates are ranked by the error \
 on held-back time windows the fit never saw (each kind of event the log holds, its start, \
