@@ -167,3 +167,80 @@ fn a_current_only_log_adds_nothing_and_says_why() {
         .unwrap()
         .contains("no voltages"));
 }
+
+/// `compare` ends with where its error lives, in the JSON (`leftover`: each line with its
+/// `frequency_hz` and `reading`, the sentences in `summary`) and in the text, every line of
+/// it under 160 characters; the text's lines are the JSON's.
+#[test]
+fn compare_says_where_its_error_lives() {
+    let (p, log) = motulator();
+    let run = |extra: &[&str]| {
+        let out = Command::cargo_bin("sim-host")
+            .unwrap()
+            .arg("compare")
+            .args(extra)
+            .arg("--params")
+            .arg(&p)
+            .arg(&log)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let v: serde_json::Value = serde_json::from_str(&run(&["--json"])).unwrap();
+    let l = &v["leftover"];
+    assert!(l.is_object(), "{v:#}");
+    // The paper's model on a direct-on-line start and a load step: far above its floor, the
+    // error in the start and the load move more than in their time.
+    assert_eq!(l["at_floor"], false);
+    assert!(l["ratio_to_floor"].as_f64().unwrap() > 10.0, "{l:#}");
+    let kinds: Vec<&str> = l["in_time"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|k| k["kind"].as_str().unwrap())
+        .collect();
+    assert!(
+        kinds.contains(&"start") && kinds.contains(&"steady"),
+        "{kinds:?}"
+    );
+    let shares: f64 = l["in_time"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|k| k["share"].as_f64().unwrap())
+        .sum();
+    assert!((shares - 1.0).abs() < 1e-6, "{shares}");
+    for x in l["lines"].as_array().unwrap() {
+        assert!(x["frequency_hz"].as_f64().unwrap() > 0.0, "{x:#}");
+        assert!(x["reading"].is_string() && x["says"].is_string(), "{x:#}");
+    }
+    let summary: Vec<&str> = l["summary"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_str().unwrap())
+        .collect();
+    assert!(
+        summary[0].starts_with("leftover: the error "),
+        "{summary:?}"
+    );
+    assert!(summary.iter().any(|s| s.starts_with("equations: ")));
+    assert!(summary.iter().any(|s| s.starts_with("in time (")));
+    let text = run(&[]);
+    let at = text.find("leftover: ").expect("a leftover in the text");
+    let block: Vec<&str> = text[at..].lines().collect();
+    assert_eq!(block.len(), summary.len(), "{text}");
+    for (t, s) in block.iter().zip(&summary) {
+        assert_eq!(t.trim(), s.trim(), "{text}");
+    }
+    let indented = text[..at].lines().last().map_or(0, str::len);
+    for line in &block {
+        let n = line.chars().count() + indented + 2;
+        assert!(n <= 160, "{n} chars: {line}");
+    }
+}

@@ -16,6 +16,7 @@ use crate::analysis::{align, Analysis, AnalysisError, FittedEffect, MAX_ITER};
 use crate::effects::EffectModel;
 use crate::fit::machine::{self, MachineFit};
 use crate::fit::{ActiveEffect, BaseSpec, FitResult};
+use crate::leftover::Leftover;
 use crate::metrics::{self, Weights};
 use crate::prep::Prepared;
 use crate::simplified_model::BaseParams;
@@ -41,16 +42,23 @@ pub struct FinalFit {
     pub fitted: Vec<FittedEffect>,
     /// Samples the fit used.
     pub fit_samples: usize,
+    /// Its error over time on the working series, as [`super::LadderStep::error_over_time`].
+    #[serde(skip)]
+    pub error_over_time: Vec<(f64, f64)>,
 }
 
 impl Ladder<'_> {
     /// The model of the rung the ladder stopped on refitted on the whole working series
     /// (coarsened as `compare`'s fit), from its values (`start_error`: the start's
-    /// whole-log error); `None` when a set-up refuses the series.
+    /// whole-log error), with where its error lives ([`crate::leftover::locate`]); `None`
+    /// when a set-up refuses the series.
     ///
     /// # Errors
     /// A model that cannot be set up on the log.
-    pub(super) fn final_fit(&self, start_error: f64) -> Result<Option<FinalFit>, AnalysisError> {
+    pub(super) fn final_fit(
+        &self,
+        start_error: f64,
+    ) -> Result<Option<(FinalFit, Option<Leftover>)>, AnalysisError> {
         let (file, rung, sr) = (self.file, &self.rung, &self.series);
         let (fdata, _) = file.fit_data();
         let an = file.rebased(rung.scales.apply(&sr.file));
@@ -74,7 +82,17 @@ impl Ladder<'_> {
         let noise = metrics::noise_floor(&file.data, &all, Some((&pred, &renoised)));
         let error = metrics::errors(&file.data, &pred, None).normalized_rms_error;
         let fitted = fin.fitted_effects(&active, &fit)?;
-        Ok(Some(FinalFit {
+        let leftover = (metrics::diverged_at(&file.data, &pred).is_none())
+            .then(|| {
+                let m = crate::leftover::Measured {
+                    error,
+                    noise_floor: noise,
+                    band: super::FLOOR_BAND,
+                };
+                crate::leftover::locate(&file.data, &fin.constants, &pred, m)
+            })
+            .flatten();
+        let chosen = FinalFit {
             effects: rung.kinds.clone(),
             error,
             noise_floor: noise,
@@ -83,7 +101,9 @@ impl Ladder<'_> {
             base: base_changes(&mf.scales, &sr.file, &half),
             fitted,
             fit_samples: fdata.len(),
-        }))
+            error_over_time: metrics::error_over_time(&file.data, &pred, &all.inv_rms),
+        };
+        Ok(Some((chosen, leftover)))
     }
 
     /// The model of the rung the ladder stopped on (its effects set up as `set`; `an` the
