@@ -13,7 +13,8 @@ use serde::Serialize;
 pub const BIN_S: f64 = 0.1;
 /// The fewest bins a correlation is computed on.
 const MIN_BINS: usize = 8;
-/// The multiples of the shaft angle the error is projected on.
+/// The multiples of the shaft angle the error is projected on (once and twice per
+/// revolution: [`shaft_angle`] takes the second's sin and cos from the first's).
 const ANGLE_MULTIPLES: [u32; 2] = [1, 2];
 
 /// A variable the error's envelope is set against.
@@ -169,61 +170,94 @@ fn correlates(d: &Prepared, es: &ErrorSeries, runs: &[(usize, usize)]) -> Vec<Co
         .collect()
 }
 
-/// The shaft angle theta_m [rad] over the first `len` samples of `d`: the measured
-/// electrical speed over the pole pairs `np`, integrated by the trapezoid rule from 0 at
-/// the log's first sample.
-fn shaft_theta(d: &Prepared, np: f64, len: usize) -> Vec<f64> {
-    let np = np.max(1.0);
-    let mut theta = vec![0.0; len];
-    for k in 1..len {
-        let dt = d.t_s[k] - d.t_s[k - 1];
-        theta[k] = theta[k - 1] + 0.5 * (d.omega_r[k] + d.omega_r[k - 1]) / np * dt;
-    }
-    theta
+/// Sums of one channel's normalised error `x` over the samples projected: of `x`, of `x^2`,
+/// and of `x cos(m theta)`, `x sin(m theta)` for each multiple `m` of [`ANGLE_MULTIPLES`].
+#[derive(Default, Clone, Copy)]
+struct AngleSums {
+    x: f64,
+    xx: f64,
+    xc: [f64; 2],
+    xs: [f64; 2],
 }
 
-/// The error's projection on sin and cos of k theta over `runs`, theta the shaft angle
-/// integrated from the measured speed from the log's first sample; empty without a speed.
+/// The sums [`shaft_angle`] projects with, over the samples of `runs`: per channel of `es`
+/// ([`AngleSums`]), of cos and sin of m theta, and the samples counted; theta the shaft
+/// angle integrated (trapezoid rule) from the measured speed (`np` pole pairs) from 0 at the
+/// log's first sample, sin and cos of 2 theta from those of theta.
+fn angle_sums(
+    d: &Prepared,
+    np: f64,
+    es: &ErrorSeries,
+    runs: &[(usize, usize)],
+) -> (Vec<AngleSums>, AngleSums, usize) {
+    let mut sums = vec![AngleSums::default(); es.channels.len()];
+    let mut trig = AngleSums::default();
+    let (mut theta, mut count) = (0.0, 0usize);
+    let mut run = runs.iter().peekable();
+    for k in 0..es.len() {
+        if k > 0 {
+            let dt = d.t_s[k] - d.t_s[k - 1];
+            theta += 0.5 * (d.omega_r[k] + d.omega_r[k - 1]) / np * dt;
+        }
+        while run.peek().is_some_and(|r| r.1 <= k) {
+            run.next();
+        }
+        if run.peek().is_none_or(|r| r.0 > k) {
+            continue;
+        }
+        let (s1, c1) = theta.sin_cos();
+        let (c, s) = ([c1, c1 * c1 - s1 * s1], [s1, 2.0 * s1 * c1]);
+        for m in 0..2 {
+            trig.xc[m] += c[m];
+            trig.xs[m] += s[m];
+        }
+        for (ch, acc) in es.channels.iter().zip(sums.iter_mut()) {
+            let x = ch.e(k) / ch.scale;
+            acc.x += x;
+            acc.xx += x * x;
+            for m in 0..2 {
+                acc.xc[m] += x * c[m];
+                acc.xs[m] += x * s[m];
+            }
+        }
+        count += 1;
+    }
+    (sums, trig, count)
+}
+
+/// The error's projection on sin and cos of k theta over `runs` ([`angle_sums`]: theta the
+/// shaft angle from the measured speed), each channel's mean taken out; empty without a
+/// speed.
 fn shaft_angle(
     d: &Prepared,
     n: &MachineConstants,
     es: &ErrorSeries,
     runs: &[(usize, usize)],
 ) -> Vec<ShaftAngle> {
-    let len = es.len();
-    if !d.channels.speed || d.omega_r.len() < len || runs.is_empty() {
+    if !d.channels.speed || d.omega_r.len() < es.len() || runs.is_empty() {
         return Vec::new();
     }
-    let theta = shaft_theta(d, n.np, len);
-    let samples = || runs.iter().flat_map(|&(a, b)| a..b);
-    let count = samples().count().max(1) as f64;
-    let totals: Vec<f64> = es
-        .channels
-        .iter()
-        .map(|c| samples().map(|k| (c.e[k] / c.scale).powi(2)).sum::<f64>() / count)
-        .collect();
-    let total: f64 = totals.iter().sum();
+    let (sums, trig, count) = angle_sums(d, n.np.max(1.0), es, runs);
+    let count = count.max(1) as f64;
+    let total: f64 = sums.iter().map(|a| a.xx).sum::<f64>() / count;
     if total <= 0.0 {
         return Vec::new();
     }
     ANGLE_MULTIPLES
         .iter()
-        .map(|&m| {
+        .enumerate()
+        .map(|(m, &per_revolution)| {
+            // Each channel's amplitude [its unit] and the mean square it holds.
             let parts: Vec<(f64, f64)> = es
                 .channels
                 .iter()
-                .map(|c| {
-                    let mean = samples().map(|k| c.e[k]).sum::<f64>() / count;
-                    let (mut a, mut b) = (0.0, 0.0);
-                    for k in samples() {
-                        let (s, co) = (m as f64 * theta[k]).sin_cos();
-                        let x = (c.e[k] - mean) / c.scale;
-                        a += x * co;
-                        b += x * s;
-                    }
-                    let (a, b) = (2.0 * a / count, 2.0 * b / count);
+                .zip(&sums)
+                .map(|(ch, acc)| {
+                    let mean = acc.x / count;
+                    let a = 2.0 * (acc.xc[m] - mean * trig.xc[m]) / count;
+                    let b = 2.0 * (acc.xs[m] - mean * trig.xs[m]) / count;
                     let amp = a.hypot(b);
-                    (amp * c.scale, 0.5 * amp * amp)
+                    (amp * ch.scale, 0.5 * amp * amp)
                 })
                 .collect();
             let ms: f64 = parts.iter().map(|p| p.1).sum();
@@ -234,7 +268,7 @@ fn shaft_angle(
                 .map_or((0, 0.0), |(c, p)| (c, p.0));
             let eq = es.channels[c].equation;
             ShaftAngle {
-                per_revolution: m,
+                per_revolution,
                 share: ms / total,
                 equation: eq,
                 amplitude: amp,

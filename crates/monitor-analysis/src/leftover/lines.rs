@@ -248,12 +248,12 @@ fn spectra(es: &ErrorSeries, starts: &[usize], n: usize) -> Spectra {
     for c in &es.channels {
         let mut p = vec![0.0; n / 2];
         for &o in starts {
-            let x = &c.e[o..o + n];
-            let mean = x.iter().sum::<f64>() / n as f64 / c.scale;
-            total += x.iter().map(|v| (v / c.scale).powi(2)).sum::<f64>() / n as f64 / s;
+            let x = |j: usize| c.e(o + j) / c.scale;
+            let mean = (0..n).map(x).sum::<f64>() / n as f64;
+            total += (0..n).map(|j| x(j).powi(2)).sum::<f64>() / n as f64 / s;
             offset += mean * mean / s;
-            for (b, (v, w)) in buf.iter_mut().zip(x.iter().zip(&win)) {
-                *b = C64::new((v / c.scale - mean) * w, 0.0);
+            for (j, (b, w)) in buf.iter_mut().zip(&win).enumerate() {
+                *b = C64::new((x(j) - mean) * w, 0.0);
             }
             fft(&mut buf);
             for (k, pk) in p.iter_mut().enumerate().skip(1) {

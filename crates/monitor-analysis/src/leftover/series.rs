@@ -6,29 +6,50 @@ use crate::metrics::white_noise_sigma;
 use crate::prep::{Prepared, C64};
 use crate::simplified_model::Prediction;
 
+/// Where an equation's error comes from.
+enum ErrorSource<'a> {
+    /// Model - measured, read from the two series when asked (no copy of a long log).
+    Difference(&'a [f64], &'a [f64]),
+    /// Computed once (the d axis: the current vectors' difference turned into the frame).
+    Stored(Vec<f64>),
+}
+
 /// One equation's error series.
-pub(super) struct Channel {
+pub(super) struct Channel<'a> {
     /// The equation.
     pub(super) equation: Equation,
-    /// Model - measured, per sample [its unit].
-    pub(super) e: Vec<f64>,
+    /// Where its error comes from.
+    source: ErrorSource<'a>,
     /// What it is normalised by: the RMS of what it measures [its unit].
     pub(super) scale: f64,
     /// The channel's white sensor noise [its unit].
     pub(super) noise: f64,
 }
 
-/// The error of a prediction over a log, per equation.
-pub(super) struct ErrorSeries {
-    /// The equations present (q always; d when the model predicts it; the mechanics with a
-    /// speed column).
-    pub(super) channels: Vec<Channel>,
+impl Channel<'_> {
+    /// Its error at sample `k`, model - measured [its unit].
+    #[inline]
+    pub(super) fn e(&self, k: usize) -> f64 {
+        match &self.source {
+            ErrorSource::Difference(p, m) => p[k] - m[k],
+            ErrorSource::Stored(v) => v[k],
+        }
+    }
 }
 
-impl ErrorSeries {
+/// The error of a prediction over a log, per equation.
+pub(super) struct ErrorSeries<'a> {
+    /// The equations present (q always; d when the model predicts it; the mechanics with a
+    /// speed column).
+    pub(super) channels: Vec<Channel<'a>>,
+    /// Samples.
+    len: usize,
+}
+
+impl<'a> ErrorSeries<'a> {
     /// The error of `p` against `d`; `None` when `p` does not cover `d` or a value is not
     /// finite.
-    pub(super) fn of(d: &Prepared, p: &Prediction) -> Option<Self> {
+    pub(super) fn of(d: &'a Prepared, p: &'a Prediction) -> Option<Self> {
         let n = d.len();
         if n < 16 || p.iq.len() < n || p.i_ab.len() < n || p.omega_r.len() < n {
             return None;
@@ -40,7 +61,7 @@ impl ErrorSeries {
         let i_scale = rms(&mut d.i_ab.iter().take(n).map(|c| c.norm())).max(1e-9);
         let mut channels = vec![Channel {
             equation: Equation::StatorQ,
-            e: (0..n).map(|k| p.iq[k] - d.iq[k]).collect(),
+            source: ErrorSource::Difference(&p.iq[..n], &d.iq[..n]),
             scale: i_scale,
             noise: white_noise_sigma(&d.iq),
         }];
@@ -50,7 +71,7 @@ impl ErrorSeries {
                 .collect();
             channels.push(Channel {
                 equation: Equation::StatorD,
-                e,
+                source: ErrorSource::Stored(e),
                 scale: i_scale,
                 noise: white_noise_sigma(&d.id),
             });
@@ -60,19 +81,19 @@ impl ErrorSeries {
             if scale > 1e-9 {
                 channels.push(Channel {
                     equation: Equation::Mechanics,
-                    e: (0..n).map(|k| p.omega_r[k] - d.omega_r[k]).collect(),
+                    source: ErrorSource::Difference(&p.omega_r[..n], &d.omega_r[..n]),
                     scale,
                     noise: white_noise_sigma(&d.omega_r),
                 });
             }
         }
-        let finite = channels.iter().all(|c| c.e.iter().all(|v| v.is_finite()));
-        finite.then_some(ErrorSeries { channels })
+        let finite = channels.iter().all(|c| (0..n).all(|k| c.e(k).is_finite()));
+        finite.then_some(ErrorSeries { channels, len: n })
     }
 
     /// Samples.
     pub(super) fn len(&self) -> usize {
-        self.channels.first().map_or(0, |c| c.e.len())
+        self.len
     }
 
     /// The error's energy at sample `k`: the sum over the equations of the squared error
@@ -80,7 +101,7 @@ impl ErrorSeries {
     pub(super) fn energy_at(&self, k: usize) -> f64 {
         self.channels
             .iter()
-            .map(|c| (c.e[k] / c.scale).powi(2))
+            .map(|c| (c.e(k) / c.scale).powi(2))
             .sum()
     }
 
@@ -92,7 +113,7 @@ impl ErrorSeries {
             .channels
             .iter()
             .map(|c| {
-                let ms = c.e.iter().map(|v| v * v).sum::<f64>() / n;
+                let ms = (0..self.len).map(|k| c.e(k).powi(2)).sum::<f64>() / n;
                 let excess = (ms - c.noise * c.noise).max(0.0) / (c.scale * c.scale);
                 (ms.sqrt(), excess)
             })
