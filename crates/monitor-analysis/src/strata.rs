@@ -63,9 +63,15 @@ pub(crate) fn load_moves(iq: &[f64], dt: f64) -> Vec<bool> {
         .map(|x| x.abs())
         .filter(|x| x.is_finite())
         .collect();
-    mags.sort_by(f64::total_cmp);
-    let median = mags.get(mags.len() / 2).copied().unwrap_or(0.0);
-    let peak = mags.last().copied().unwrap_or(0.0);
+    // The median by selection (the value a sort puts in the middle, without the sort: a long
+    // log's strata are cut for compare's leftover too).
+    let peak = mags.iter().copied().fold(0.0f64, f64::max);
+    let mid = mags.len() / 2;
+    let median = if mags.is_empty() {
+        0.0
+    } else {
+        *mags.select_nth_unstable_by(mid, f64::total_cmp).1
+    };
     let range = median.max(0.02 * peak).max(1e-9);
     let mut moved = vec![false; len];
     for k in (w + look)..len {

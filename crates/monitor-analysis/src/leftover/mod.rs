@@ -232,6 +232,7 @@ pub fn locate(d: &Prepared, n: &MachineConstants, p: &Prediction, m: Measured) -
         Err(because) => (ErrorSpectrum::Refused { because }, Vec::new()),
     };
     let (follows, shaft_angle) = follows::follows(d, n, &es, &strata);
+    let all = every_stratum(&es, &strata, d);
     let ratio = error / noise_floor;
     let at_floor = ratio <= band;
     let mut out = Leftover {
@@ -241,8 +242,8 @@ pub fn locate(d: &Prepared, n: &MachineConstants, p: &Prediction, m: Measured) -
         band,
         at_floor,
         equations: es.equation_shares(),
-        in_time: in_time(&es, &strata, d),
-        windows: windows(&es, &strata, d),
+        in_time: in_time(&all),
+        windows: windows(&all),
         spectrum,
         lines,
         follows,
@@ -253,39 +254,56 @@ pub fn locate(d: &Prepared, n: &MachineConstants, p: &Prediction, m: Measured) -
     Some(out)
 }
 
-/// The error's energy over the samples `a..b`.
-fn energy(es: &series::ErrorSeries, a: usize, b: usize) -> f64 {
-    (a..b.min(es.len())).map(|k| es.energy_at(k)).sum()
-}
-
-/// The strata's kinds with their shares of the error's energy and of the log's time.
-fn in_time(
+/// Every stratum of the log (`strata` cover it) with its share of the error's energy and of
+/// the log's time: one pass over the samples.
+fn every_stratum(
     es: &series::ErrorSeries,
     strata: &[(StratumKind, usize, usize)],
     d: &Prepared,
-) -> Vec<KindShare> {
-    let total = energy(es, 0, es.len()).max(f64::MIN_POSITIVE);
-    let len = es.len().max(1) as f64;
+) -> Vec<WindowShare> {
+    let len = es.len();
+    let energies: Vec<f64> = strata
+        .iter()
+        .map(|&(_, a, b)| (a..b.min(len)).map(|k| es.energy_at(k)).sum())
+        .collect();
+    let total = energies.iter().sum::<f64>().max(f64::MIN_POSITIVE);
+    strata
+        .iter()
+        .zip(energies)
+        .filter(|(s, _)| s.1 < len)
+        .map(|(&(kind, a, b), e)| {
+            let b = b.min(len);
+            WindowShare {
+                kind,
+                t_start_s: d.t_s[a],
+                t_end_s: d.t_s[b - 1],
+                share: e / total,
+                time_share: (b - a) as f64 / len.max(1) as f64,
+            }
+        })
+        .collect()
+}
+
+/// The strata's kinds with their shares of the error's energy and of the log's time, from
+/// every stratum's ([`every_stratum`]).
+fn in_time(all: &[WindowShare]) -> Vec<KindShare> {
     let mut out: Vec<KindShare> = Vec::new();
-    for &(kind, a, b) in strata.iter().filter(|s| s.1 < es.len()) {
-        let b = b.min(es.len());
-        let e = energy(es, a, b) / total;
-        let (t0, t1) = (d.t_s[a], d.t_s[b - 1]);
-        match out.iter_mut().find(|k| k.kind == kind) {
+    for w in all {
+        match out.iter_mut().find(|k| k.kind == w.kind) {
             Some(k) => {
                 k.strata += 1;
-                k.share += e;
-                k.time_share += (b - a) as f64 / len;
-                k.t_start_s = k.t_start_s.min(t0);
-                k.t_end_s = k.t_end_s.max(t1);
+                k.share += w.share;
+                k.time_share += w.time_share;
+                k.t_start_s = k.t_start_s.min(w.t_start_s);
+                k.t_end_s = k.t_end_s.max(w.t_end_s);
             }
             None => out.push(KindShare {
-                kind,
+                kind: w.kind,
                 strata: 1,
-                t_start_s: t0,
-                t_end_s: t1,
-                share: e,
-                time_share: (b - a) as f64 / len,
+                t_start_s: w.t_start_s,
+                t_end_s: w.t_end_s,
+                share: w.share,
+                time_share: w.time_share,
             }),
         }
     }
@@ -293,29 +311,14 @@ fn in_time(
     out
 }
 
-/// The strata that hold the most error for their length: share at least twice their
-/// time's, at most three, the most concentrated first.
-fn windows(
-    es: &series::ErrorSeries,
-    strata: &[(StratumKind, usize, usize)],
-    d: &Prepared,
-) -> Vec<WindowShare> {
-    let total = energy(es, 0, es.len()).max(f64::MIN_POSITIVE);
-    let len = es.len().max(1) as f64;
-    let mut out: Vec<WindowShare> = strata
+/// The strata that hold the most error for their length (of every stratum's,
+/// [`every_stratum`]): share at least twice their time's and 5 %, at most three, the most
+/// concentrated first.
+fn windows(all: &[WindowShare]) -> Vec<WindowShare> {
+    let mut out: Vec<WindowShare> = all
         .iter()
-        .filter(|s| s.1 < es.len())
-        .map(|&(kind, a, b)| {
-            let b = b.min(es.len());
-            WindowShare {
-                kind,
-                t_start_s: d.t_s[a],
-                t_end_s: d.t_s[b - 1],
-                share: energy(es, a, b) / total,
-                time_share: (b - a) as f64 / len,
-            }
-        })
         .filter(|w| w.share >= 2.0 * w.time_share && w.share >= 0.05)
+        .cloned()
         .collect();
     out.sort_by(|a, b| (b.share / b.time_share).total_cmp(&(a.share / a.time_share)));
     out.truncate(3);
