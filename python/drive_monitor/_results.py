@@ -120,9 +120,43 @@ class DiagnoseResult(Result):
         return _frame(self._doc.get("unbalance", {}).get("segments", []))
 
 
-class CompareResult(Result):
+class _LeftoverMixin:
+    """Where the model's remaining error lives (the document's ``leftover``)."""
+
+    @property
+    def leftover_lines(self):
+        """The strongest spectral lines of the model's remaining error (``leftover.lines``)
+        as a DataFrame: ``frequency_hz``, its ``reading`` (``shaft_frequency``,
+        ``twice_slip_frequency``, ``supply_frequency``, ``not_named``) with its
+        ``multiple`` and the ``expected_hz`` on this log, ``says`` (the reading in words),
+        ``share`` of the error, ``amplitude`` and ``unit`` in the ``equation`` it is
+        strongest in; empty where nothing is left to place (or no leftover was computed)."""
+        doc = self._doc.get("leftover") or {}
+        keep = (
+            "frequency_hz",
+            "reading",
+            "multiple",
+            "expected_hz",
+            "says",
+            "share",
+            "amplitude",
+            "unit",
+            "equation",
+            "prominence",
+        )
+        import pandas as pd
+
+        rows = [{k: x.get(k) for k in keep} for x in doc.get("lines", [])]
+        return pd.DataFrame(rows, columns=list(keep))
+
+
+class CompareResult(_LeftoverMixin, Result):
     """``compare``'s report. Keys: ``effects``, ``normalized_rms_error``, ``noise_floor``,
-    ``channels``, ``worst_windows``, ``base_parameters``, ``unbalance``, ``data_quality``."""
+    ``channels``, ``worst_windows``, ``base_parameters``, ``unbalance``, ``data_quality``,
+    ``leftover`` (where the error lives: ``equations``, ``in_time``, ``windows``,
+    ``spectrum``, ``lines`` each with ``frequency_hz`` and ``reading``, ``follows``,
+    ``shaft_angle``, ``hint``, ``summary``; ``.leftover_lines`` is its lines as a
+    DataFrame)."""
 
     @property
     def channels_frame(self):
@@ -163,13 +197,15 @@ class ExplainResult(Result):
         return _frame([{k: r.get(k) for k in keep} for r in self._doc.get("ranking", [])])
 
 
-class LadderResult(Result):
+class LadderResult(_LeftoverMixin, Result):
     """``explain --ladder``'s report. Keys: ``summary`` (what was found, then why it
     stopped), ``base_changes`` (the base parameters that differ from the file, with their
     intervals), ``final_fit`` (the chosen model refitted on the whole log), ``start``,
     ``ladder`` (the steps in order: an effect added, with what it dropped, or the base
     parameters refitted), ``stop``, ``stopped_because``, ``final_effects``, ``last_round``,
-    ``skipped``, ``split``, ``test``, ``data``, ``data_quality``."""
+    ``skipped``, ``split``, ``test``, ``data``, ``data_quality``, ``leftover`` (where the
+    chosen model's error lives when the ladder stops above the noise floor, else None; as
+    ``compare``'s; ``.leftover_lines`` is its lines as a DataFrame)."""
 
     @property
     def base_frame(self):

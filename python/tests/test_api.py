@@ -85,6 +85,12 @@ def test_compare_explain_identify_nameplate(repo, sim_host):
                    "--effects", "load_torque")
     assert c.to_dict() == cli
     assert c.normalized_rms_error < 0.05
+    # Where the error lives, as the command line says it: the lines each with their
+    # frequency and reading, the same words.
+    assert c.leftover.summary[0].startswith("leftover: ")
+    lines = c.leftover_lines
+    assert list(lines.columns[:2]) == ["frequency_hz", "reading"]
+    assert len(lines) == len(cli["leftover"]["lines"])
     e = dm.explain(repo / MOTULATOR, repo / MOTULATOR_P, from_s=0.8)
     assert e.ranking[0].effect == "load_torque"
     # The same document; its advice names Python's keyword where the command names its flag.

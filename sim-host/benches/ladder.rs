@@ -80,7 +80,7 @@ fn main() {
             fit_base: true,
             laws: Default::default(),
         };
-        let r = a.ladder(&opts, &|_, _| {}).expect("ladder");
+        let r = a.ladder(&opts, &|_| {}).expect("ladder");
         let wall = t0.elapsed().as_secs_f64();
         let cpu = common::stat_seconds(11) - c0;
         let named: Vec<&str> = r

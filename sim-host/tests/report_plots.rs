@@ -355,12 +355,13 @@ fn the_ladders_chart_names_each_step_on_a_whole_tick() {
         })
         .filter(|t| !t.2.is_empty())
         .collect();
+    // A step's name is its number, a colon and what it did (a tick of the y axis, `1`, is
+    // not one).
     let steps: Vec<&(f64, f64, String)> = texts
         .iter()
         .filter(|t| {
-            t.2.split(':')
-                .next()
-                .is_some_and(|k| k.parse::<usize>().is_ok())
+            t.2.split_once(": ")
+                .is_some_and(|(k, _)| k.parse::<usize>().is_ok())
         })
         .collect();
     assert!(steps.len() >= 2, "{texts:?}");
@@ -389,4 +390,90 @@ fn the_ladders_chart_names_each_step_on_a_whole_tick() {
         steps.len(),
         "other ticks beside the steps: {on_line:?}"
     );
+    // The error over time: the model as configured, each kept step named as on the axis,
+    // the chosen model refitted, its floor and the log's events (the load step at 2.5 s).
+    let svg = std::fs::read_to_string(dir.join("ladder_time.svg")).expect("the time chart");
+    let legend = chart_legend::legend(&svg).expect("a legend");
+    let names: Vec<&str> = legend.iter().map(|e| e.label.as_str()).collect();
+    assert_eq!(names[0], "0: as configured", "{names:?}");
+    for s in &steps[1..] {
+        assert!(
+            names.contains(&s.2.as_str()),
+            "{} not drawn: {names:?}",
+            s.2
+        );
+    }
+    assert!(
+        names.contains(&"end: refitted on the whole log"),
+        "{names:?}"
+    );
+    assert!(
+        names
+            .iter()
+            .any(|n| n.starts_with("log events ") && n.ends_with("load moves")),
+        "{names:?}"
+    );
+    // It falls in time: the first step's worst supply period is below the start's.
+    let top = |label: &str| {
+        legend
+            .iter()
+            .find(|e| e.label == label)
+            .and_then(|e| e.y_range)
+            .map(|r| r.1)
+            .unwrap_or_else(|| panic!("{label}: {legend:?}"))
+    };
+    assert!(top(&steps[1].2) < top("0: as configured"), "{legend:?}");
+    let html = std::fs::read_to_string(dir.join("report.html")).expect("report");
+    assert!(html.contains("The ladder over time"), "the report draws it");
+}
+
+/// `compare --plot` draws the model it was asked for: each chart's legend names its
+/// effects, and the error drawn is that model's (with the load torque, the q current's
+/// error over time is a fraction of the paper's model's, which cannot follow the load
+/// step).
+#[test]
+fn compare_draws_the_model_it_was_asked_for() {
+    let tmp = tempfile::tempdir().expect("tmp");
+    let (paper, lt) = (tmp.path().join("paper"), tmp.path().join("lt"));
+    run(&[
+        "compare",
+        "--from",
+        "0.8",
+        "--plot",
+        paper.to_str().expect("utf8"),
+    ]);
+    run(&[
+        "compare",
+        "--from",
+        "0.8",
+        "--effects",
+        "load_torque",
+        "--plot",
+        lt.to_str().expect("utf8"),
+    ]);
+    let legend_of = |dir: &Path, stem: &str| {
+        let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).expect(stem);
+        chart_legend::legend(&svg).expect("a legend")
+    };
+    for stem in ["error_time", "error_spectrum", "overlay_iqs"] {
+        let with = legend_of(&lt, stem);
+        assert!(
+            with.iter()
+                .any(|e| e.label.contains("the paper's model + load_torque")),
+            "{stem}: {with:?}"
+        );
+        let without = legend_of(&paper, stem);
+        assert!(
+            without
+                .iter()
+                .any(|e| e.label.contains("the paper's model"))
+                && !without.iter().any(|e| e.label.contains("load_torque")),
+            "{stem}: {without:?}"
+        );
+    }
+    // The errors drawn: both models meet the load step's transient, but only the paper's
+    // keeps an offset after it.
+    let range = |dir: &Path| legend_of(dir, "error_time")[0].y_range.expect("drawn");
+    let (lt, paper) = (range(&lt), range(&paper));
+    assert!(lt.1 < paper.1 && lt.0 < 0.2 * paper.0, "{lt:?} {paper:?}");
 }

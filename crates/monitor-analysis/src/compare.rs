@@ -60,6 +60,9 @@ pub struct CompareReport {
     pub data: DataInfo,
     /// What the data-quality stage found and what the analysis did about it.
     pub data_quality: monitor_io::log::quality::DataQuality,
+    /// Where the model's error lives: its equations, windows, spectral lines and what it
+    /// follows ([`crate::leftover`]); null where the model could not run or diverged.
+    pub leftover: Option<crate::leftover::Leftover>,
 }
 
 /// An analysis `compare` could not run on a log.
@@ -177,6 +180,7 @@ impl Analysis {
                 unbalance,
                 data: info,
                 data_quality: self.quality.clone(),
+                leftover: m.leftover,
             },
             prediction: m.prediction,
             all_windows: m.all_windows,
@@ -234,8 +238,18 @@ impl Analysis {
         for (w, t) in worst.iter_mut().zip(tags) {
             w.transient = t;
         }
+        let diverged_at_s = metrics::diverged_at(d, &pred);
+        let leftover = diverged_at_s.is_none().then(|| {
+            let m = crate::leftover::Measured {
+                error: err.normalized_rms_error,
+                noise_floor,
+                band: super::explain::NOISE_MARGIN,
+            };
+            crate::leftover::locate(d, &self.constants, &pred, m)
+        });
         Ok(CompareMeasures {
-            diverged_at_s: metrics::diverged_at(d, &pred),
+            diverged_at_s,
+            leftover: leftover.flatten(),
             noise_floor,
             err,
             worst,
@@ -293,6 +307,8 @@ struct CompareMeasures {
     advice: Vec<super::transients::Advice>,
     /// The prediction.
     prediction: Prediction,
+    /// Where its error lives (`None` where it diverged).
+    leftover: Option<crate::leftover::Leftover>,
 }
 
 impl Analysis {
@@ -323,6 +339,7 @@ impl Analysis {
                 unbalance,
                 data: info,
                 data_quality: self.quality.clone(),
+                leftover: None,
             },
             prediction: Prediction::default(),
             all_windows: vec![],

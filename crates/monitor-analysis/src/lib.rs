@@ -44,12 +44,14 @@ pub mod effects;
 pub mod explain;
 pub mod fit;
 pub mod identify;
+pub mod leftover;
 pub mod lm;
 pub mod metrics;
 pub mod prep;
 pub mod refit;
 pub mod rotor_asymmetry;
 pub mod simplified_model;
+pub mod strata;
 pub mod transients;
 pub mod unbalance;
 

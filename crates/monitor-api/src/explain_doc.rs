@@ -104,7 +104,7 @@ pub fn ladder(
 ) -> Result<serde_json::Value, ApiError> {
     let log = &log.into();
     let a = load_analysis(params, log, req, &mut |_| {})?;
-    let report = a.ladder(&req.options(&a)?, &|_, _| {})?;
+    let report = a.ladder(&req.options(&a)?, &|_| {})?;
     Ok(monitor_words::ladder::document(&report, spell))
 }
 

@@ -14,8 +14,8 @@ use serde_json::Value;
 /// `compare --json`'s document: the report's typed values with the sentences beside them
 /// (`advice` beside `advice_values`, `skipped` beside `skipped_reasons`, `not_identified`
 /// beside `not_identified_values`, `implausible_because` with a diverged prediction first,
-/// and the unbalance's `summary` and `cannot_judge_because`); `spell` names the options
-/// the advice refers to.
+/// the unbalance's `summary` and `cannot_judge_because`, and where the error lives,
+/// `leftover.summary`); `spell` names the options the advice refers to.
 pub fn document(r: &CompareReport, spell: &dyn Spelling) -> Value {
     let mut doc = serde_json::to_value(r).unwrap_or_default();
     let Some(obj) = doc.as_object_mut() else {
@@ -40,6 +40,9 @@ pub fn document(r: &CompareReport, spell: &dyn Spelling) -> Value {
     }
     if let Some(u) = obj.get_mut("unbalance") {
         unbalance_into(u, &r.unbalance, spell);
+    }
+    if let (Some(v), Some(l)) = (obj.get_mut("leftover"), &r.leftover) {
+        crate::leftover::into_json(v, l);
     }
     doc
 }

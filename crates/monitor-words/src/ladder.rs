@@ -16,7 +16,8 @@ use serde_json::Value;
 /// `explain --ladder --json`'s document: the report's typed values, with the sentences a
 /// crew reads beside them (`summary`, `stopped_because` beside `stopped_reason`, `skipped`
 /// beside `skipped_reasons`, `test` beside `test_rule`, each step's `summary`, each
-/// candidate's `because` beside its `refusal`); `spell` names the options advice refers to.
+/// candidate's `because` beside its `refusal`, and where the error lives when the ladder
+/// stops above the floor, `leftover.summary`); `spell` names the options advice refers to.
 pub fn document(r: &LadderReport, spell: &dyn Spelling) -> Value {
     let mut doc = serde_json::to_value(r).unwrap_or_default();
     let Some(obj) = doc.as_object_mut() else {
@@ -44,6 +45,9 @@ pub fn document(r: &LadderReport, spell: &dyn Spelling) -> Value {
                 o.insert("because".into(), refusal(&t.refusal).into());
             }
         }
+    }
+    if let (Some(v), Some(l)) = (obj.get_mut("leftover"), &r.leftover) {
+        crate::leftover::into_json(v, l);
     }
     doc
 }

@@ -23,6 +23,9 @@
 //! - [`identify`]: `identify` (why an identification is not written);
 //! - [`ladder`]: `explain --ladder` (why it stopped, why a candidate was not kept, each
 //!   step, the base changes, what was found, and its JSON document);
+//! - [`leftover`]: where a model's remaining error lives (`compare`'s end, the ladder's
+//!   stop above the floor): its equations, windows, spectral lines, what it follows, the
+//!   law it points to;
 //! - [`diagnose`]: one log's report (`sim-host diagnose`, the demo, the HMI, Python's
 //!   `diagnose`), its [`diagnose::Story`] and its JSON document;
 //! - [`trend`]: a motor's trend (`sim-host trend`, Python's `trend`).
@@ -37,6 +40,7 @@ pub mod explain;
 pub mod identify;
 pub mod ladder;
 pub mod laws;
+pub mod leftover;
 mod spelling;
 pub mod trend;
 

@@ -174,7 +174,9 @@ condition{speed_rpm, load_current_a, voltage_v, voltage_percent, supply_hz, \
 time_since_start_s}, dominant_error_hz, error_kind}], base_parameters, fitted_effects, \
 skipped, unbalance, data, data_quality (what the data-quality stage found in the log: gaps, \
 dropped samples, bad cells, segments, and what was done; the longest regular segment is \
-analysed)."
+analysed), leftover (where the error lives: equations, in_time, windows, spectrum, lines \
+[{frequency_hz, reading, multiple, expected_hz, share, amplitude, says}], follows, \
+shaft_angle, hint, summary)."
 )]
 pub struct CompareArgs {
     /// Shared options.
@@ -252,7 +254,7 @@ pub struct ExplainArgs {
     /// heldback_ratio_to_floor, significance, explained, heldback_explained}], stop
     /// (noise_floor | nothing_helps | library_exhausted | no_model | untrusted),
     /// stopped_because, final_effects, last_round, skipped, split, test, data,
-    /// data_quality.
+    /// data_quality, leftover (where the error lives when it stops above the floor).
     #[arg(long, conflicts_with_all = ["compare", "rotor_bars"], long_help = ladder_help())]
     pub ladder: bool,
 }
@@ -262,7 +264,7 @@ pub struct ExplainArgs {
 /// cannot disagree.
 fn ladder_help() -> String {
     format!(
-        "Walk the ladder instead of ranking once: add the effect that lowers the held-back error most, keep it when the step passes its test (it removes at least {:.0} % of the held-back error beyond the noise floor and lowers the whole-log error), and go on from the new model until the error is within the noise-floor band or nothing plausible helps. One row per step; --report draws the error falling onto the floor. JSON: start, ladder [{{effect, added, fitted {{name: {{value, unit, low, high}}}}, error, heldback_error, noise_floor, heldback_noise_floor, ratio_to_floor, heldback_ratio_to_floor, significance, explained, heldback_explained}}], stop (noise_floor | nothing_helps | library_exhausted | no_model | untrusted), stopped_because, final_effects, last_round, skipped, split, test, data, data_quality.",
+        "Walk the ladder instead of ranking once: add the effect that lowers the held-back error most, keep it when the step passes its test (it removes at least {:.0} % of the held-back error beyond the noise floor and lowers the whole-log error), and go on from the new model until the error is within the noise-floor band or nothing plausible helps. One row per step; --report draws the error falling onto the floor. JSON: start, ladder [{{effect, added, fitted {{name: {{value, unit, low, high}}}}, error, heldback_error, noise_floor, heldback_noise_floor, ratio_to_floor, heldback_ratio_to_floor, significance, explained, heldback_explained}}], stop (noise_floor | nothing_helps | library_exhausted | no_model | untrusted), stopped_because, final_effects, last_round, skipped, split, test, data, data_quality, leftover (where the error lives when it stops above the floor: equations, in_time, spectrum, lines [{{frequency_hz, reading, ...}}], follows, hint).",
         100.0 * monitor_api::analysis::STEP_MIN
     )
 }
@@ -409,17 +411,19 @@ fn print_explain(
 /// # Errors
 /// As [`run_compare`].
 fn run_ladder(c: &Common) -> anyhow::Result<()> {
-    c.check(&[render::charts::LADDER])?;
+    c.check(&render::ladder_charts::LADDER_CHARTS)?;
     let (a, _) = c.load()?;
-    // A bar whenever the walk runs longer than 2 s: each step's candidates, then the
-    // chosen model's refit on the whole log.
+    // A bar whenever the walk runs longer than 2 s: each round's candidates, then the
+    // chosen model's refit on the whole log; it only goes forward
+    // ([`progress::ladder_position`]).
     let pb = progress::LateBar::new(
-        "ladder step 1: fitting candidates",
+        "ladder round 1 (no step kept yet): fitting candidates",
         std::time::Duration::from_secs(2),
     );
     let opts = c.options(&a)?;
-    let report = a.ladder(&opts, &|step, f| {
-        pb.set(Some(format!("ladder step {step}: fitting")), f);
+    let report = a.ladder(&opts, &|p| {
+        let (msg, at) = progress::ladder_position(p);
+        pb.set(Some(msg), at);
     })?;
     pb.finish();
     render::html::write_ladder(c.plot.as_deref(), c.report.as_deref(), &c.log, &report)?;

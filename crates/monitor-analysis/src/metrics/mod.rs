@@ -10,8 +10,10 @@ use super::prep::{phase_values, Prepared, C64};
 use super::simplified_model::Prediction;
 use serde::Serialize;
 
+mod trace;
 mod worst;
 
+pub use trace::{error_over_time, TRACE_POINTS};
 pub use worst::{error_kind, windows, Condition, WorstWindow};
 
 /// Channel names, in order.

@@ -6,7 +6,6 @@ use monitor_api::analysis::EffectId;
 use monitor_api::analysis::Prediction;
 use monitor_api::analysis::Prepared;
 use monitor_api::analysis::{metrics, WorstWindow};
-use monitor_api::analysis::{LadderReport, LadderStep, FLOOR_BAND};
 
 /// The charts `compare` writes (file stems; each as `.svg` and `.png`; the zoomed panels
 /// only for a log long enough to be drawn as envelopes, a scatter only where the log spans
@@ -34,82 +33,6 @@ pub const EXPLAIN: [&str; 5] = [
     "zoom_before_after_iqs_2",
     "before_after_error",
 ];
-
-/// The chart `explain --ladder` writes: the error after each step onto the floor band.
-pub const LADDER: &str = "ladder";
-
-/// The ladder chart's name of step `k` (`s`), as its tick reads: its number (the table's)
-/// and what it added (`1: +load_torque`), refitted (`2: base refit`) or removed
-/// (`3: +saturation -load_torque`).
-fn step_name(k: usize, s: &LadderStep) -> String {
-    let mut name = match s.effect {
-        None => "base refit".to_string(),
-        Some(_) => s
-            .added
-            .iter()
-            .map(|e| format!("+{}", e.name()))
-            .collect::<Vec<_>>()
-            .join(" "),
-    };
-    for d in &s.dropped {
-        name.push_str(&format!(" -{}", d.name()));
-    }
-    format!("{k}: {name}")
-}
-
-/// `explain --ladder`'s chart: the whole-log and the held-back error after each step (step 0:
-/// the model as configured) on a logarithmic axis, with the noise floor and the band's top
-/// ([`FLOOR_BAND`] times it) as lines: the error falls step by step onto the band. The x
-/// axis has one tick per step, named by what the step added ([`step_name`]).
-pub fn ladder_chart(r: &LadderReport) -> Chart<'static> {
-    let mut whole = vec![(0.0, r.start.error)];
-    let mut held = vec![(0.0, r.start.heldback_error)];
-    let mut floor = vec![(0.0, r.start.noise_floor)];
-    for (k, s) in r.ladder.iter().enumerate() {
-        let x = (k + 1) as f64;
-        whole.push((x, s.error));
-        held.push((x, s.heldback_error));
-        floor.push((x, s.noise_floor));
-    }
-    let band: Vec<(f64, f64)> = floor.iter().map(|&(x, y)| (x, FLOOR_BAND * y)).collect();
-    let line = |label: String, points: Vec<(f64, f64)>, color: usize, dashed: bool| Series {
-        label,
-        points,
-        color,
-        scatter: false,
-        dashed,
-    };
-    let omitted = (!r.start.error.is_finite()).then(|| monitor_api::words::ladder::stopped(r));
-    Chart {
-        stem: LADDER,
-        title: "The ladder: the model's error after each step, onto the noise floor",
-        x_label: "step: what it added (+ an effect, or the base parameters refitted), as the table numbers it",
-        y_label: "normalized RMS error",
-        series: vec![
-            line("whole log".into(), whole.clone(), 0, false),
-            Series {
-                label: "whole log (each step)".into(),
-                points: whole,
-                color: 0,
-                scatter: true,
-                dashed: false,
-            },
-            line("held-back windows".into(), held, 1, false),
-            line("noise floor".into(), floor, 2, true),
-            line(
-                format!("floor band ({FLOOR_BAND}x the floor)"),
-                band,
-                3,
-                true,
-            ),
-        ],
-        log_y: true,
-        omitted,
-        x_names: std::iter::once("0: as configured".to_string())
-            .chain(r.ladder.iter().enumerate().map(|(k, s)| step_name(k + 1, s)))
-            .collect(),
-    }
-}
 
 /// Every file a chart set can write (for the output guard).
 pub fn file_names(stems: &[&str]) -> Vec<String> {
@@ -309,25 +232,37 @@ fn zoom(d: &Prepared, worst: &[WorstWindow]) -> (usize, usize) {
     (a, (a + per).min(n))
 }
 
-/// Builds the `compare` charts: overlays (envelopes over a long log, with zoomed panels at
-/// the worst periods), error vs time (one unit per chart), error vs operating variables,
-/// error spectrum.
+/// The model `compare` ran, as its charts' legends name it: the paper's, with the
+/// configured effects.
+fn model_label(effects: &[EffectId]) -> String {
+    if effects.is_empty() {
+        "the paper's model".into()
+    } else {
+        let names: Vec<&str> = effects.iter().map(|e| e.name()).collect();
+        format!("the paper's model + {}", names.join(" + "))
+    }
+}
+
+/// Builds the `compare` charts of the model it was asked for (its effects named in every
+/// legend): overlays (envelopes over a long log, with zoomed panels at the worst periods),
+/// error vs time (one unit per chart), error vs operating variables, error spectrum.
 pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> {
     let p = &out.prediction;
     if p.iq.is_empty() {
         return Vec::new();
     }
+    let model = model_label(&out.report.effects);
     let eiq: Vec<f64> = p.iq.iter().zip(&d.iq).map(|(a, b)| a - b).collect();
-    let mut v = overlays(d, p, &eiq, &out.report.worst_windows);
-    v.extend(errors_over_time(d, p, &eiq));
-    v.extend(condition_charts(d, &out.all_windows));
+    let mut v = overlays(d, p, &eiq, &out.report.worst_windows, &model);
+    v.extend(errors_over_time(d, p, &eiq, &model));
+    v.extend(condition_charts(d, &out.all_windows, &model));
     v.push(Chart {
         stem: "error_spectrum",
         title: "Spectrum of the q-axis current's error",
         x_label: "frequency [Hz]",
         y_label: "amplitude [A]",
         series: vec![Series {
-            label: "I_qs error".into(),
+            label: format!("I_qs error of {model}"),
             points: plot::thin(&metrics::spectrum(&eiq, d.dt_s), MAX_POINTS),
             color: 4,
             scatter: false,
@@ -341,22 +276,23 @@ pub fn compare_charts(d: &Prepared, out: &CompareOutput) -> Vec<Chart<'static>> 
 }
 
 /// The measured and predicted I_qs and speed over the log, I_qs zoomed where its error
-/// `eiq` is worst, and the phase current around the worst window of `worst`.
+/// `eiq` is worst, and the phase current around the worst window of `worst` (`model`: the
+/// model's name in the legends).
 fn overlays(
     d: &Prepared,
     p: &Prediction,
     eiq: &[f64],
     worst: &[WorstWindow],
+    model: &str,
 ) -> Vec<Chart<'static>> {
-    let t = &d.t_s;
-    let per = period_samples(d);
+    let (t, per) = (&d.t_s, period_samples(d));
     let mut v = vec![over_time(
         "overlay_iqs",
         "q-axis current I_qs: measured vs model",
         "I_qs [A]",
         vec![
             trace("measured", t, &d.iq, per, 0, Per::Mean),
-            trace("model", t, &p.iq, per, 1, Per::Mean),
+            trace(model, t, &p.iq, per, 1, Per::Mean),
         ],
     )];
     if d.channels.speed {
@@ -366,7 +302,7 @@ fn overlays(
             "omega_r [rad/s]",
             vec![
                 trace("measured", t, &d.omega_r, per, 0, Per::Mean),
-                trace("model", t, &p.omega_r, per, 1, Per::Mean),
+                trace(model, t, &p.omega_r, per, 1, Per::Mean),
             ],
         ));
     }
@@ -378,7 +314,7 @@ fn overlays(
             "q-axis current, a few supply periods where the model is worst: measured vs model",
             "q-axis current, a few supply periods where the model is second worst: measured vs model",
         ],
-        &[("measured", &d.iq, 0, false), ("model", &p.iq, 1, false)],
+        &[("measured", &d.iq, 0, false), (model, &p.iq, 1, false)],
     ));
     let (a, b) = zoom(d, worst);
     v.push(over_time(
@@ -393,7 +329,7 @@ fn overlays(
                 0,
             ),
             line(
-                "model",
+                model,
                 &t[a..b],
                 (a..b).map(|k| metrics::predicted(d, p, k)[2]),
                 1,
@@ -403,15 +339,23 @@ fn overlays(
     v
 }
 
-/// The model's errors over time: I_qs (`eiq`) and, with a speed column, the speed.
-fn errors_over_time(d: &Prepared, p: &Prediction, eiq: &[f64]) -> Vec<Chart<'static>> {
+/// The model's errors over time: I_qs (`eiq`) and, with a speed column, the speed
+/// (`model`: its name in the legends).
+fn errors_over_time(d: &Prepared, p: &Prediction, eiq: &[f64], model: &str) -> Vec<Chart<'static>> {
     let t = &d.t_s;
     let per = period_samples(d);
     let mut v = vec![over_time(
         "error_time",
         "Error of the q-axis current vs time (model - measured)",
         "I_qs error [A]",
-        vec![trace("I_qs error", t, eiq, per, 1, Per::Rms)],
+        vec![trace(
+            &format!("I_qs error of {model}"),
+            t,
+            eiq,
+            per,
+            1,
+            Per::Rms,
+        )],
     )];
     if d.channels.speed {
         let e: Vec<f64> = p
@@ -424,7 +368,14 @@ fn errors_over_time(d: &Prepared, p: &Prediction, eiq: &[f64]) -> Vec<Chart<'sta
             "error_time_omega_r",
             "Error of the rotor speed vs time (model - measured)",
             "omega_r error [rad/s]",
-            vec![trace("omega_r error", t, &e, per, 2, Per::Rms)],
+            vec![trace(
+                &format!("omega_r error of {model}"),
+                t,
+                &e,
+                per,
+                2,
+                Per::Rms,
+            )],
         ));
     }
     v
@@ -449,8 +400,8 @@ fn one_operating_point(x_label: &str, points: &[(f64, f64)]) -> Option<String> {
 }
 
 /// Window error against the operating condition: speed, load current, voltage, time since
-/// start (one point per window).
-fn condition_charts(d: &Prepared, all: &[WorstWindow]) -> Vec<Chart<'static>> {
+/// start (one point per window of `model`'s prediction).
+fn condition_charts(d: &Prepared, all: &[WorstWindow], model: &str) -> Vec<Chart<'static>> {
     let wpts = |f: &dyn Fn(&WorstWindow) -> Option<f64>| -> Vec<(f64, f64)> {
         all.iter()
             .filter_map(|w| f(w).map(|x| (x, w.normalized_rms_error)))
@@ -496,7 +447,7 @@ fn condition_charts(d: &Prepared, all: &[WorstWindow]) -> Vec<Chart<'static>> {
             omitted: one_operating_point(xl, &points),
             x_names: Vec::new(),
             series: vec![Series {
-                label: "window".into(),
+                label: format!("window of {model}"),
                 points,
                 color: 3,
                 scatter: true,

@@ -120,7 +120,12 @@ pub fn write_ladder(
     write_outputs(
         plot,
         report,
-        || vec![charts::ladder_chart(r)],
+        || {
+            vec![
+                super::ladder_charts::ladder_chart(r),
+                super::ladder_charts::ladder_time_chart(r),
+            ]
+        },
         |svgs| ladder_html(&log, r, svgs),
     )
 }
@@ -163,6 +168,14 @@ fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> Stri
         "<p>The test: {}.</p>",
         esc(&monitor_api::words::ladder::test(&r.test_rule))
     );
+    ladder_end_html(&mut h, r);
+    h.push_str("</body></html>");
+    h
+}
+
+/// The ladder page's end: the last round's other candidates, the effects not fitted on the
+/// log, and where the error lives when the ladder stopped above the floor.
+fn ladder_end_html(h: &mut String, r: &LadderReport) {
     if !r.last_round.is_empty() {
         h.push_str("<h2>The last round's other candidates</h2><ul>");
         for t in &r.last_round {
@@ -183,8 +196,26 @@ fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> Stri
         }
         h.push_str("</ul>");
     }
-    h.push_str("</body></html>");
-    h
+    leftover_html(h, r.leftover.as_ref());
+}
+
+/// Where the model's error lives ([`words::leftover::lines`]): its headline, then a list.
+fn leftover_html(h: &mut String, l: Option<&monitor_api::analysis::Leftover>) {
+    let Some(l) = l else {
+        return;
+    };
+    let lines = words::leftover::lines(l);
+    let Some((head, rest)) = lines.split_first() else {
+        return;
+    };
+    let _ = write!(h, "<h2>Where the error lives</h2><p>{}</p>", esc(head));
+    if !rest.is_empty() {
+        h.push_str("<ul>");
+        for x in rest {
+            let _ = write!(h, "<li>{}</li>", esc(x.trim_start()));
+        }
+        h.push_str("</ul>");
+    }
 }
 
 /// The table row of the ladder's step `s` (number `k`): what it added, changed or
@@ -280,6 +311,7 @@ fn compare_html(log: &str, out: &CompareOutput, charts: &[(String, String)]) -> 
         "<h2>Unbalance</h2><p>{}</p>",
         esc(&words::analysis::unbalance(&r.unbalance, CLI))
     );
+    leftover_html(&mut h, r.leftover.as_ref());
     for (title, svg) in charts {
         let _ = write!(h, "<h3>{}</h3>{svg}", esc(title));
     }

@@ -1,6 +1,7 @@
 //! One renderer per output format, as a CLI tool keeps its exporters: [`text`] (the human
 //! tables; [`bench_text`] the benchmarks'), [`json`] (one document), [`html`] (the report
-//! page and the chart files; [`diagnose_html`] `diagnose`'s page), with the chart sets in [`charts`] drawn by [`plot`]; [`hmi`]
+//! page and the chart files; [`diagnose_html`] `diagnose`'s page), with the chart sets in [`charts`]
+//! (the ladder's in [`ladder_charts`]) drawn by [`plot`] (the legend placed by [`legend`]); [`hmi`]
 //! draws the live HMI's screen. The text and JSON renderers write to the writer they are
 //! given (the commands pass [`crate::cli::out::stdout`]; a test can pass a `Vec<u8>`).
 
@@ -10,6 +11,8 @@ pub mod diagnose_html;
 pub mod hmi;
 pub mod html;
 pub mod json;
+pub mod ladder_charts;
+pub mod legend;
 pub mod mcsa;
 pub mod plot;
 pub mod text;

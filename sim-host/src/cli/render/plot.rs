@@ -195,65 +195,43 @@ fn log_tick(v: &f64) -> String {
     }
 }
 
-/// Where the legend goes: the corner of the plot (or the right's middle) the series cross
-/// least, counted on their points and, for lines, on points along their segments, in the
-/// plot's own scale (`log_y`: the logarithm's) within `ranges`.
-fn legend_position(
-    c: &Chart,
-    ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
-) -> SeriesLabelPosition {
-    let ty = |y: f64| {
-        if c.log_y {
-            y.max(f64::MIN_POSITIVE).log10()
-        } else {
-            y
-        }
+/// The chart's margin [px] on every side ([`draw`]).
+pub(super) const MARGIN_PX: u32 = 12;
+/// The y labels' area [px].
+pub(super) const Y_LABELS_PX: u32 = 70;
+/// The caption's height [px] (a 20 px title and the space below it).
+const CAPTION_PX: u32 = 30;
+/// A legend line's height [px] (plotters' 12 px labels, one a line).
+const LEGEND_LINE_PX: f64 = 16.0;
+
+/// Where chart `c`'s legend goes and the y range that leaves it room
+/// ([`super::legend::place`]), the plot's and the legend's sizes as drawn: the plot is the
+/// chart less its caption, label areas and margins; the legend one line per entry, a
+/// 30 px mark beside the labels, 10 px margins.
+fn legend_place(c: &Chart, ranges: ((f64, f64), (f64, f64))) -> (SeriesLabelPosition, (f64, f64)) {
+    let chars = c
+        .series
+        .iter()
+        .map(|s| s.label.chars().count())
+        .max()
+        .unwrap_or(0) as f64;
+    let layout = super::legend::Layout {
+        plot_px: (
+            f64::from(WIDTH_PX - 2 * MARGIN_PX - Y_LABELS_PX),
+            f64::from(height(c) - 2 * MARGIN_PX - CAPTION_PX - 40 - upright_names_px(c)),
+        ),
+        legend_px: (
+            chars * f64::from(LABEL_CHAR_PX) + 50.0,
+            c.series.len() as f64 * LEGEND_LINE_PX + 20.0,
+        ),
+        log_y: c.log_y,
     };
-    let (ly0, ly1) = (ty(y0), ty(y1));
-    let (w, hgt) = (
-        (x1 - x0).max(f64::MIN_POSITIVE),
-        (ly1 - ly0).max(f64::MIN_POSITIVE),
-    );
-    // The candidates' boxes as shares of the plot: (x from, x to, y from, y to), y upwards.
-    let boxes = [
-        (SeriesLabelPosition::UpperRight, (0.6, 1.0, 0.65, 1.0)),
-        (SeriesLabelPosition::UpperLeft, (0.0, 0.4, 0.65, 1.0)),
-        (SeriesLabelPosition::LowerRight, (0.6, 1.0, 0.0, 0.35)),
-        (SeriesLabelPosition::LowerLeft, (0.0, 0.4, 0.0, 0.35)),
-        (SeriesLabelPosition::MiddleRight, (0.6, 1.0, 0.33, 0.67)),
-    ];
-    let mut counts = [0usize; 5];
-    for s in &c.series {
-        let pts: Vec<(f64, f64)> = s
-            .points
-            .iter()
-            .filter(|p| drawable(p, c.log_y))
-            .map(|&(x, y)| ((x - x0) / w, (ty(y) - ly0) / hgt))
-            .collect();
-        let along = !s.scatter && pts.len() < 400;
-        let mut visit = |(x, y): (f64, f64)| {
-            for (k, (_, (a, b, lo, hi))) in boxes.iter().enumerate() {
-                if (*a..=*b).contains(&x) && (*lo..=*hi).contains(&y) {
-                    counts[k] += 1;
-                }
-            }
-        };
-        for (k, &p) in pts.iter().enumerate() {
-            visit(p);
-            if along && k > 0 {
-                let q = pts[k - 1];
-                for j in 1..10 {
-                    let f = f64::from(j) / 10.0;
-                    visit((q.0 + f * (p.0 - q.0), q.1 + f * (p.1 - q.1)));
-                }
-            }
-        }
-    }
-    let best = (0..boxes.len()).min_by_key(|&k| counts[k]).unwrap_or(0);
-    boxes
-        .into_iter()
-        .nth(best)
-        .map_or(SeriesLabelPosition::UpperRight, |b| b.0)
+    let series: Vec<(&[(f64, f64)], bool)> = c
+        .series
+        .iter()
+        .map(|s| (s.points.as_slice(), s.scatter))
+        .collect();
+    super::legend::place(&series, &layout, ranges)
 }
 
 /// DejaVu Sans 2.37 (Bitstream Vera licence: `assets/fonts/LICENSE-DejaVu.txt`), the PNG
@@ -349,7 +327,13 @@ fn ranges(c: &Chart) -> ((f64, f64), (f64, f64)) {
         y1 = y0 + y0.abs().max(1e-9);
     }
     if c.log_y {
-        ((x0, x1), (y0.max(y1 * 1e-7), y1 * 1.5))
+        // From the power of ten at or below the lowest value: a labelled tick at or below
+        // every value drawn (a noise floor at 0.004 had no label below 0.01).
+        // (A hair below it: the axis' first labelled power is the one at or above its
+        // start, and log10(0.001) rounds to -2.9999999999999996.)
+        let lo = y0.max(y1 * 1e-7);
+        let decade = 10f64.powf(lo.log10().floor()) * (1.0 - 1e-9);
+        ((x0, x1), (decade, y1 * 1.5))
     } else {
         let m = 0.05 * (y1 - y0);
         ((x0, x1), (y0 - m, y1 + m))
@@ -375,13 +359,17 @@ where
     root.fill(&WHITE).map_err(e)?;
     let ((x0, x1), (y0, y1)) = ranges(c);
     let mut b = ChartBuilder::on(&root);
-    b.margin(12);
+    b.margin(MARGIN_PX);
     if text {
         b.caption(c.title, ("sans-serif", 20))
             .x_label_area_size(40 + upright_names_px(c))
-            .y_label_area_size(70);
+            .y_label_area_size(Y_LABELS_PX);
     }
-    let corner = legend_position(c, ((x0, x1), (y0, y1)));
+    let (corner, (y0, y1)) = if text {
+        legend_place(c, ((x0, x1), (y0, y1)))
+    } else {
+        (SeriesLabelPosition::UpperRight, (y0, y1))
+    };
     let ticks = if c.log_y {
         let chart = b
             .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
@@ -875,3 +863,7 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "plot_tests.rs"]
+mod more_tests;

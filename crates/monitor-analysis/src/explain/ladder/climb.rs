@@ -6,7 +6,7 @@
 
 use super::refusal::{StopReason, WhatIsLeft};
 use super::rung::{LadderSeries, Rung};
-use super::{LadderReport, LadderStart, LadderStep, Tried, FLOOR_BAND};
+use super::{LadderProgress, LadderReport, LadderStart, LadderStep, Tried, FLOOR_BAND};
 use crate::analysis::{Analysis, AnalysisError, Options};
 use crate::effects::EffectModel;
 use crate::explain::Skipped;
@@ -25,8 +25,8 @@ pub(super) struct Ladder<'a> {
     pub(super) series: LadderSeries,
     /// The effects the user configured: the start, never dropped.
     pub(super) configured: Vec<EffectId>,
-    /// Gets the step (1-based) and the fraction of its candidates fitted.
-    pub(super) progress: &'a (dyn Fn(usize, f64) + Sync),
+    /// Gets where the ladder is.
+    pub(super) progress: &'a (dyn Fn(LadderProgress) + Sync),
     /// The rung the ladder stands on.
     pub(super) rung: Rung<'a>,
     /// The analysis of that rung's base parameters: the file recentred on them (`None`:
@@ -52,7 +52,7 @@ impl<'a> Ladder<'a> {
         configured: &'a [Box<dyn EffectModel>],
         opts: &Options,
         held: Vec<bool>,
-        progress: &'a (dyn Fn(usize, f64) + Sync),
+        progress: &'a (dyn Fn(LadderProgress) + Sync),
     ) -> Result<Self, AnalysisError> {
         let series = LadderSeries::of(file, held, opts.fit_base);
         let active = file.setup_all(&series.fd, configured)?;
@@ -89,6 +89,7 @@ impl<'a> Ladder<'a> {
             noise_floor: r.noise,
             heldback_noise_floor: r.heldback_noise,
             ratio_to_floor: r.error / r.noise,
+            error_over_time: r.over_time.clone(),
         }
     }
 
@@ -130,7 +131,8 @@ impl<'a> Ladder<'a> {
         let moved = next.scales != self.rung.scales;
         let next_an = moved.then(|| self.file.rebased(next.scales.apply(&self.series.file)));
         let an = next_an.as_ref().unwrap_or(self.standing());
-        let (next, step) = self.drop_stand_ins(an, next, step, &self.rung)?;
+        let (next, mut step) = self.drop_stand_ins(an, next, step, &self.rung)?;
+        step.error_over_time = next.over_time.clone();
         self.steps.push(step);
         self.rung = next;
         if moved {
@@ -181,13 +183,24 @@ impl<'a> Ladder<'a> {
         reason: StopReason,
         report: &mut LadderReport,
     ) -> Result<(), AnalysisError> {
-        let step_no = self.steps.len() + 1;
-        (self.progress)(step_no, 0.0);
+        let kept = self.steps.len();
+        (self.progress)(LadderProgress::FinalFit {
+            kept,
+            fraction: 0.0,
+        });
         let fin = self.final_fit(report.start.error)?;
-        (self.progress)(step_no, 1.0);
+        (self.progress)(LadderProgress::FinalFit {
+            kept,
+            fraction: 1.0,
+        });
+        let (fin, leftover) = fin.map_or((None, None), |(f, l)| (Some(f), l));
         if let Some(f) = &fin {
             report.base_changes = f.base.iter().filter(|c| c.changed).cloned().collect();
         }
+        // Where the error lives, when the ladder stops above the floor (or the chosen
+        // model, refitted on the whole log, ends above it).
+        let at_floor = matches!(reason, StopReason::NoiseFloor { .. });
+        report.leftover = leftover.filter(|l| !(at_floor && l.at_floor));
         report.final_fit = fin;
         report.stop = reason.stop();
         report.stopped_reason = reason;

@@ -16,6 +16,7 @@ use crate::analysis::{align, Analysis, AnalysisError, FittedEffect, MAX_ITER};
 use crate::effects::EffectModel;
 use crate::fit::machine::{self, BaseKey, MachineFit};
 use crate::fit::{ActiveEffect, BaseSpec, FitResult};
+use crate::leftover::Leftover;
 use crate::metrics::{self, Weights};
 use crate::prep::Prepared;
 use crate::simplified_model::BaseParams;
@@ -41,16 +42,32 @@ pub struct FinalFit {
     pub fitted: Vec<FittedEffect>,
     /// Samples the fit used.
     pub fit_samples: usize,
+    /// Its error over time on the working series, as [`super::LadderStep::error_over_time`].
+    #[serde(skip)]
+    pub error_over_time: Vec<(f64, f64)>,
+}
+
+/// The chosen model on the whole working series (`Ladder::on_whole_log`).
+struct WholeLog {
+    error: f64,
+    noise: f64,
+    fitted: Vec<FittedEffect>,
+    leftover: Option<Leftover>,
+    error_over_time: Vec<(f64, f64)>,
 }
 
 impl Ladder<'_> {
     /// The model of the rung the ladder stopped on refitted on the whole working series
     /// (coarsened as `compare`'s fit), from its values (`start_error`: the start's
-    /// whole-log error); `None` when a set-up refuses the series.
+    /// whole-log error), with where its error lives ([`crate::leftover::locate`]); `None`
+    /// when a set-up refuses the series.
     ///
     /// # Errors
     /// A model that cannot be set up on the log.
-    pub(super) fn final_fit(&self, start_error: f64) -> Result<Option<FinalFit>, AnalysisError> {
+    pub(super) fn final_fit(
+        &self,
+        start_error: f64,
+    ) -> Result<Option<(FinalFit, Option<Leftover>)>, AnalysisError> {
         let (file, rung, sr) = (self.file, &self.rung, &self.series);
         let (fdata, _) = file.fit_data();
         let an = file.rebased(rung.scales.apply(&sr.file));
@@ -58,7 +75,8 @@ impl Ladder<'_> {
             return Ok(None);
         };
         let (mf, half) = self.machine_on(&an, &fdata, &set)?;
-        let (error, noise, fitted) = self.on_whole_log(&mf)?;
+        let whole = self.on_whole_log(&mf, true)?;
+        let (error, noise) = (whole.error, whole.noise);
         let mut base = base_changes(&mf.scales, &sr.file, &half);
         if sr.fit_base {
             for c in base.iter_mut().filter(|c| c.changed) {
@@ -66,24 +84,24 @@ impl Ladder<'_> {
                 c.changed = c.not_separable.is_none();
             }
         }
-        Ok(Some(FinalFit {
+        let chosen = FinalFit {
             effects: rung.kinds.clone(),
             error,
             noise_floor: noise,
             ratio_to_floor: error / noise,
             below_start: start_error / error,
             base,
-            fitted,
+            fitted: whole.fitted,
             fit_samples: fdata.len(),
-        }))
+            error_over_time: whole.error_over_time,
+        };
+        Ok(Some((chosen, whole.leftover)))
     }
 
     /// The chosen model at the machine fit `mf` on the whole working series: its error,
-    /// its noise floor and its effects' values.
-    fn on_whole_log(
-        &self,
-        mf: &MachineFit,
-    ) -> Result<(f64, f64, Vec<FittedEffect>), AnalysisError> {
+    /// its noise floor and its effects' values; with `story`, its error over time and where
+    /// that error lives ([`crate::leftover::locate`]).
+    fn on_whole_log(&self, mf: &MachineFit, story: bool) -> Result<WholeLog, AnalysisError> {
         let (file, rung, sr) = (self.file, &self.rung, &self.series);
         let fin = file.rebased(mf.params(&sr.file));
         let models: Vec<&dyn EffectModel> = rung.models.clone();
@@ -100,7 +118,33 @@ impl Ladder<'_> {
         let all = Weights::new(&file.data, 0, usize::MAX);
         let noise = metrics::noise_floor(&file.data, &all, Some((&pred, &renoised)));
         let error = metrics::errors(&file.data, &pred, None).normalized_rms_error;
-        Ok((error, noise, fin.fitted_effects(&active, &fit)?))
+        let fitted = fin.fitted_effects(&active, &fit)?;
+        if !story {
+            return Ok(WholeLog {
+                error,
+                noise,
+                fitted,
+                leftover: None,
+                error_over_time: Vec::new(),
+            });
+        }
+        let leftover = (metrics::diverged_at(&file.data, &pred).is_none())
+            .then(|| {
+                let m = crate::leftover::Measured {
+                    error,
+                    noise_floor: noise,
+                    band: super::FLOOR_BAND,
+                };
+                crate::leftover::locate(&file.data, &fin.constants, &pred, m)
+            })
+            .flatten();
+        Ok(WholeLog {
+            error,
+            noise,
+            fitted,
+            leftover,
+            error_over_time: metrics::error_over_time(&file.data, &pred, &all.inv_rms),
+        })
     }
 
     /// Whether the change of `key` the fit `mf` reads (whole-log error `error`, floor
@@ -131,7 +175,7 @@ impl Ladder<'_> {
             MAX_ITER,
             Some(key),
         )?;
-        let (e_pin, _, _) = self.on_whole_log(&pinned)?;
+        let e_pin = self.on_whole_log(&pinned, false)?.error;
         let removes = if e_pin > noise {
             (e_pin - error) / (e_pin - noise)
         } else {

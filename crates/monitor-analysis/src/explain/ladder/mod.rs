@@ -173,6 +173,12 @@ pub struct LadderStep {
     pub explained: f64,
     /// Share of the held-back error beyond the noise floor the step removed.
     pub heldback_explained: f64,
+    /// The model's error over time after the step on the working series, as (time [s],
+    /// `normalized_rms_error` over one supply period or more)
+    /// ([`crate::metrics::error_over_time`]):
+    /// the charts draw it falling. Not in the JSON.
+    #[serde(skip)]
+    pub error_over_time: Vec<(f64, f64)>,
 }
 
 /// An effect a step removed (JSON `ladder[].dropped_because[]`): the model without it
@@ -203,6 +209,32 @@ pub struct LadderStart {
     pub heldback_noise_floor: f64,
     /// `error / noise_floor`.
     pub ratio_to_floor: f64,
+    /// The model's error over time before the first step, as [`LadderStep::error_over_time`].
+    #[serde(skip)]
+    pub error_over_time: Vec<(f64, f64)>,
+}
+
+/// Where a ladder is, for a progress bar ([`Analysis::ladder`]'s `progress`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LadderProgress {
+    /// Round `round` (1-based) fits its candidates; `kept` steps are kept so far (the round
+    /// may keep one more, or none: then the ladder stops); `fraction` (0..1) of its fits
+    /// done.
+    Round {
+        /// The round, from 1.
+        round: usize,
+        /// The steps kept before it.
+        kept: usize,
+        /// The share of its fits done.
+        fraction: f64,
+    },
+    /// The chosen model of `kept` steps refitted on the whole log; `fraction` done.
+    FinalFit {
+        /// The steps kept.
+        kept: usize,
+        /// The share done (0 or 1).
+        fraction: f64,
+    },
 }
 
 /// A candidate of the last round that was not kept, and why (JSON `last_round`).
@@ -282,6 +314,10 @@ pub struct LadderReport {
     pub data: DataInfo,
     /// What the data-quality stage found and what the analysis did about it.
     pub data_quality: monitor_io::log::quality::DataQuality,
+    /// Where the chosen model's error lives, when the ladder stops above the noise floor
+    /// ([`crate::leftover`]: its equations, windows, spectral lines and what it follows;
+    /// null at the floor or where the model could not run).
+    pub leftover: Option<crate::leftover::Leftover>,
 }
 
 /// The held-back split of the ladder (JSON `split`).
@@ -308,15 +344,15 @@ pub struct Stratum {
 
 impl Analysis {
     /// `explain --ladder`: forward selection over the effect library from the configured
-    /// model (module doc; the climb is [`climb`]'s `Ladder`). `progress` gets the step
-    /// (1-based) and the fraction of its candidates fitted.
+    /// model (module doc; the climb is [`climb`]'s `Ladder`). `progress` gets where the
+    /// ladder is ([`LadderProgress`]).
     ///
     /// # Errors
     /// A configured effect whose needs the log does not meet.
     pub fn ladder(
         &self,
         opts: &Options,
-        progress: &(dyn Fn(usize, f64) + Sync),
+        progress: &(dyn Fn(LadderProgress) + Sync),
     ) -> Result<LadderReport, AnalysisError> {
         let (held, strata) = stratified_heldback(&self.data, &self.constants);
         let mut report = self.report_before(opts, &held, strata);
@@ -347,6 +383,7 @@ impl Analysis {
                 noise_floor: f64::NAN,
                 heldback_noise_floor: f64::NAN,
                 ratio_to_floor: f64::NAN,
+                error_over_time: Vec::new(),
             },
             ladder: Vec::new(),
             stop: Stop::NoModel,
@@ -366,6 +403,7 @@ impl Analysis {
             },
             data: self.info(),
             data_quality: self.quality.clone(),
+            leftover: None,
         }
     }
 

@@ -54,6 +54,8 @@ pub(super) struct Rung<'a> {
     /// The held-back error on the fit series (what candidates are ranked on).
     pub(super) heldback_fit_series: f64,
     pub(super) heldback_noise_fit_series: f64,
+    /// The error over time on the working series ([`metrics::error_over_time`]).
+    pub(super) over_time: Vec<(f64, f64)>,
 }
 
 /// A candidate fitted in one round.
@@ -112,6 +114,7 @@ impl LadderSeries {
         let heldback_noise = metrics::noise_floor_on(d, held, Some((&pred, &renoised)));
         let error = metrics::errors(d, &pred, None).normalized_rms_error;
         let heldback_error = metrics::errors(d, &pred, Some(held)).normalized_rms_error;
+        let over_time = metrics::error_over_time(d, &pred, &w.inv_rms);
         let (hb_fd, hn_fd) = if m == 1 {
             (heldback_error, heldback_noise)
         } else {
@@ -134,6 +137,7 @@ impl LadderSeries {
             heldback_noise,
             heldback_fit_series: hb_fd,
             heldback_noise_fit_series: hn_fd,
+            over_time,
         })
     }
 }

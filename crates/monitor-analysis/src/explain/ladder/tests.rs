@@ -34,7 +34,7 @@ fn fan_log(dir: &std::path::Path) -> Analysis {
 }
 
 /// No progress to show.
-static NO_PROGRESS: fn(usize, f64) = |_, _| {};
+static NO_PROGRESS: fn(super::LadderProgress) = |_| {};
 
 /// The ladder on the log of `a` at its start, the user having configured `configured`
 /// (the effects it never drops).
@@ -127,6 +127,7 @@ fn a_stand_in_a_later_step_explains_is_dropped() {
         significance: 1.0,
         explained: 0.0,
         heldback_explained: 0.0,
+        error_over_time: Vec::new(),
     };
     let (after, step) = ladder
         .drop_stand_ins(&a, next, step, &before)
@@ -182,6 +183,7 @@ fn what_the_user_configured_and_the_machine_order_stay() {
         significance: 1.0,
         explained: 0.0,
         heldback_explained: 0.0,
+        error_over_time: Vec::new(),
     };
     let (after, step) = ladder
         .drop_stand_ins(&a, next, step, &before)

@@ -78,6 +78,23 @@ pub fn compare(
         "  unbalance: {}",
         words::analysis::unbalance(&r.unbalance, CLI)
     )?;
+    leftover(&mut out, r.leftover.as_ref(), "  ")
+}
+
+/// Where the model's error lives ([`words::leftover::lines`]), its first line indented by
+/// `indent` and the others two more.
+fn leftover(
+    out: &mut dyn std::io::Write,
+    l: Option<&monitor_api::analysis::Leftover>,
+    indent: &str,
+) -> anyhow::Result<()> {
+    let Some(l) = l else {
+        return Ok(());
+    };
+    for (k, line) in words::leftover::lines(l).iter().enumerate() {
+        let more = if k == 0 { "" } else { "  " };
+        writeln!(out, "{indent}{more}{line}")?;
+    }
     Ok(())
 }
 
@@ -338,7 +355,7 @@ fn ladder_end(out: &mut dyn std::io::Write, r: &LadderReport) -> anyhow::Result<
         let s = words::analysis::skipped(s, CLI);
         writeln!(out, "  not fitted: {s}")?;
     }
-    Ok(())
+    leftover(out, r.leftover.as_ref(), "")
 }
 
 /// One step's row of the ladder's table (`k`: its number): `+ effect` (and `- dropped`), or

@@ -285,6 +285,7 @@ fn step_between(rung: &Rung<'_>, next: &Rung<'_>, sig: f64) -> LadderStep {
             next.heldback_error,
             next.heldback_noise,
         ),
+        error_over_time: next.over_time.clone(),
     }
 }
 

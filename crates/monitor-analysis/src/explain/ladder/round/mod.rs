@@ -74,8 +74,14 @@ impl<'a> Ladder<'a> {
     /// The step reports what it explains from the rung the round started from.
     pub(super) fn round(&self) -> Result<RoundOutcome<'a>, AnalysisError> {
         let (an, rung) = (self.standing(), &self.rung);
-        let step_no = self.steps.len() + 1;
-        let progress = |f: f64| (self.progress)(step_no, f);
+        let kept = self.steps.len();
+        let progress = |fraction: f64| {
+            (self.progress)(super::LadderProgress::Round {
+                round: kept + 1,
+                kept,
+                fraction,
+            })
+        };
         let (cands, skipped) = self.candidates(an);
         progress(0.0);
         // 1. The base rung.
