@@ -49,6 +49,9 @@ struct Machine {
 #[derive(Deserialize)]
 struct LawLog {
     name: String,
+    /// The library's laws that share a term with the true law: (name, why).
+    library_overlap: Vec<Vec<String>>,
+    frequencies: Option<Frequencies>,
     csv: String,
     params: String,
     machine: String,
@@ -56,6 +59,12 @@ struct LawLog {
     law_name: String,
     true_law: TrueLaw,
     sizes: BTreeMap<String, toml::Value>,
+}
+
+/// The log's frequencies per steady stretch: `[t_from_s, t_to_s, value]`.
+#[derive(Deserialize)]
+struct Frequencies {
+    pulsation_hz: Option<Vec<[f64; 3]>>,
 }
 
 #[derive(Deserialize)]
@@ -72,10 +81,17 @@ fn manifest() -> Manifest {
 
 /// The ladder's JSON on `log` with its user's law file.
 fn ladder(log: &LawLog) -> Value {
-    let out = Command::cargo_bin("sim-host")
-        .expect("the sim-host binary")
-        .args(["explain", "--ladder", "--json", "--laws"])
-        .arg(data().join(&log.laws))
+    ladder_with(log, true)
+}
+
+/// The ladder's JSON on `log`, with its user's law file or without.
+fn ladder_with(log: &LawLog, laws: bool) -> Value {
+    let mut cmd = Command::cargo_bin("sim-host").expect("the sim-host binary");
+    cmd.args(["explain", "--ladder", "--json"]);
+    if laws {
+        cmd.arg("--laws").arg(data().join(&log.laws));
+    }
+    let out = cmd
         .arg("--params")
         .arg(data().join(&log.params))
         .arg(data().join(&log.csv))
@@ -218,6 +234,68 @@ fn bars(log: &LawLog, machines: &[Machine]) -> Vec<String> {
         j["base_changes"].as_array().map_or(0, Vec::len)
     );
     bad
+}
+
+/// Without its law: the leftover's strongest line within 5 % of the true pulsation (where
+/// the law pulses), and no library law named in its place but those that share a term with
+/// it (the manifest's `library_overlap`: a compressor's mean torque is a constant load
+/// torque).
+fn bars_without(log: &LawLog) -> Vec<String> {
+    let j = ladder_with(log, false);
+    let mut bad = Vec::new();
+    let allowed: Vec<&str> = log
+        .library_overlap
+        .iter()
+        .filter_map(|o| o.first())
+        .map(String::as_str)
+        .collect();
+    for e in j["final_effects"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(Value::as_str)
+    {
+        if !e.ends_with("_dynamics") && !allowed.contains(&e) {
+            bad.push(format!(
+                "{} without its law: {e} named in its place",
+                log.name
+            ));
+        }
+    }
+    let pulsation = log
+        .frequencies
+        .as_ref()
+        .and_then(|f| f.pulsation_hz.as_ref());
+    if let Some(p) = pulsation {
+        let truth = p.iter().map(|s| s[2]).sum::<f64>() / p.len().max(1) as f64;
+        let line = j["leftover"]["lines"][0]["frequency_hz"]
+            .as_f64()
+            .unwrap_or(f64::NAN);
+        if !((line - truth).abs() <= 0.05 * truth) {
+            bad.push(format!(
+                "{} without its law: the leftover's strongest line {line} Hz, the pulsation {truth:.2} Hz",
+                log.name
+            ));
+        }
+        eprintln!(
+            "{} without its law: the leftover's line {line:.2} Hz (pulsation {truth:.2} Hz)",
+            log.name
+        );
+    }
+    bad
+}
+
+#[test]
+fn without_its_law_the_leftover_says_where_the_law_lives() {
+    let m = manifest();
+    let full = full_sweeps();
+    let bad: Vec<String> = m
+        .user_law_log
+        .iter()
+        .filter(|l| full || l.name == "kw7p5_pulse2")
+        .flat_map(bars_without)
+        .collect();
+    assert!(bad.is_empty(), "{bad:#?}");
 }
 
 #[test]
