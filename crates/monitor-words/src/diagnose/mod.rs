@@ -29,7 +29,7 @@ pub use verdict::{
 };
 pub use winding::{
     describe_against, line as winding_line, operating_point_source, phase_not_judged, reach,
-    shorted_turns, summary as winding_summary, suspect, widened, CREW_SHORT,
+    sequence_ratio, shorted_turns, summary as winding_summary, suspect, widened, CREW_SHORT,
 };
 
 use monitor_replay::{DiagnoseReport, MonitorState, MovedWhy};

@@ -212,14 +212,24 @@ fn events_list(h: &mut String, rep: &DiagnoseReport) {
     list(h, "Events (marked on the charts above)", &lines);
 }
 
+/// A negative-sequence ratio in per cent where it is a measurement (at most 100 %: above
+/// it the phase order is reversed, `words::sequence_ratio`), else not drawn (NaN).
+fn measured_pct(ratio: f32) -> f64 {
+    if ratio <= 1.0 {
+        100.0 * f64::from(ratio)
+    } else {
+        f64::NAN
+    }
+}
+
 /// The negative sequence: the whole log's ratio, the named phase and its confidence.
 fn winding(h: &mut String, rep: &DiagnoseReport) {
     let u = &rep.unbalance;
     let phase = words::suspect(u);
     let _ = write!(
         h,
-        "<h2>Winding</h2><p>Negative sequence |I2|/|I1| = {:.2} % (least change that names a phase {:.1} %); suspect phase: {}.</p>",
-        100.0 * u.negative_sequence_ratio,
+        "<h2>Winding</h2><p>Negative sequence |I2|/|I1| = {} (least change that names a phase {:.1} %); suspect phase: {}.</p>",
+        esc(&words::sequence_ratio(u.negative_sequence_ratio)),
         100.0 * u.least_change,
         esc(&phase)
     );
@@ -421,13 +431,13 @@ fn sequence_chart(rep: &DiagnoseReport) -> Chart<'static> {
         let pts = rep
             .timeline
             .iter()
-            .map(|p| (p.t_s, 100.0 * f64::from(p.negative_sequence_ratio)))
+            .map(|p| (p.t_s, measured_pct(p.negative_sequence_ratio)))
             .collect();
         (pts, "|I2|/|I1|".to_string())
     };
     let mut seg = Vec::new();
     for s in &rep.unbalance.segments {
-        let y = 100.0 * f64::from(s.negative_sequence_ratio);
+        let y = measured_pct(s.negative_sequence_ratio);
         seg.extend([(s.from_s, y), (s.to_s, y), (f64::NAN, f64::NAN)]);
     }
     let drawn = !pts.is_empty() || !seg.is_empty();
