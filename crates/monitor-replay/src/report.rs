@@ -156,6 +156,26 @@ impl DiagnoseReport {
         self.verdict_finding = c.finding;
     }
 
+    /// The parameter fit's finding from the machine fitted to the log (`f`,
+    /// [`crate::MachineFit::finding`]), where the residuals were judged against the file:
+    /// a fault it names replaces the residuals' parameter-fit finding; the machine on the
+    /// file replaces only a clear one (a misfit the residuals saw stands).
+    pub(crate) fn put_machine_fit(&mut self, f: FindingReport) {
+        use monitor_core::verdict::{Against, FindingSource, State};
+        let Some(old) = self
+            .findings
+            .iter()
+            .find(|g| g.source() == FindingSource::ParameterFit)
+        else {
+            return;
+        };
+        let replaces = old.finding.against == Against::ParameterFile
+            && (matches!(f.finding.state, State::Named(_)) || old.finding.state == State::Clear);
+        if replaces {
+            put(&mut self.findings, f);
+        }
+    }
+
     /// Data that cannot carry a verdict (`why`): every fault-judging finding that judged
     /// something becomes "not judged", with what it would have said (the verdict is decided
     /// after, [`DiagnoseReport::conclude`]).

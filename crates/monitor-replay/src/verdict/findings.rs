@@ -60,6 +60,15 @@ pub(crate) fn isolation_name(
     }
 }
 
+/// Whether the isolation's equations departed from its baseline in a way it names no fault
+/// for and heating does not explain.
+fn deviates_unexplained(iso: &IsolationReport) -> bool {
+    use monitor_core::IsolationState;
+    matches!(iso.state, IsolationState::Isolated | IsolationState::Unknown)
+        && iso.named.is_none()
+        && !iso.heating_explains
+}
+
 /// Why the parameter file does not fit the log (JSON `{"kind": ..}`).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -180,6 +189,14 @@ impl Stages<'_> {
         let lit_end = inp.out.lamps.iter().any(|l| *l);
         if let Some(why) = self.operating_point_explains(inp, lit_end) {
             return of(State::Explained, why);
+        }
+        if against == Against::ParameterFile && deviates_unexplained(iso) {
+            // Against the file's nominal values, a change the isolation's steady-state
+            // equations saw beyond the healthy spread, that names no fault and that heating
+            // does not explain, is no "clear": a fault present from the first sample and a
+            // file off the machine look the same there (the parameter fit says which it
+            // cannot tell).
+            return of(State::Unexplained, Detail::Isolation);
         }
         if !inp.detected && !lit_end {
             return of(State::Clear, Detail::Isolation);

@@ -87,9 +87,11 @@ fn summary_of(detail: &Detail, rep: &DiagnoseReport, sp: &dyn Spelling) -> Strin
                 .into()
         }
         Detail::FileMisfit(m) => format!(
-            "the parameter file does not fit this log (commission on the healthy motor, or identify it: sim-host identify): {}",
+            "the log departs from the parameter file: a file off the machine, or a fault present from the start, \
+             look the same here (commission on the healthy motor, or identify it from a healthy log): {}",
             file_misfit(m, rep, sp)
         ),
+        Detail::MachineFit(f) => super::machine_fit::summary(f),
         Detail::DataNotTrusted => format!(
             "data quality: {}",
             rep.data_quality.not_trusted_because.join("; ")
@@ -181,7 +183,8 @@ pub fn brief(f: &FindingReport, rep: &DiagnoseReport, sp: &dyn Spelling) -> Stri
                 residuals()
             )
         }
-        Detail::Isolation | Detail::LampsOutOfRange { .. } => residuals(),
+        Detail::Isolation => format!("{}{}", residuals(), super::machine_fit::reach(rep, against)),
+        Detail::LampsOutOfRange { .. } => residuals(),
         Detail::Winding => winding::brief(&rep.unbalance, against, sp),
         Detail::Rotor => rotor::brief(&rep.rotor),
         Detail::OperatingPointUnavailable | Detail::Steady | Detail::OperatingPointMoved { .. } => {
@@ -190,7 +193,8 @@ pub fn brief(f: &FindingReport, rep: &DiagnoseReport, sp: &dyn Spelling) -> Stri
         Detail::Commissioned
         | Detail::ParameterFitUnavailable
         | Detail::FileFits
-        | Detail::FileMisfit(_) => "parameter file".into(),
+        | Detail::FileMisfit(_)
+        | Detail::MachineFit(_) => "parameter file".into(),
         Detail::DataNotTrusted
         | Detail::DataNotJudged { .. }
         | Detail::DataClean

@@ -10,6 +10,7 @@
 
 mod commissioning;
 mod findings;
+mod machine_fit;
 mod isolation;
 mod named;
 mod rotor;

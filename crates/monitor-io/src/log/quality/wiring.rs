@@ -28,7 +28,7 @@
 //! ([`WiringFault::fix`]: the parameter file's `[columns]` entries), and withholds the
 //! verdict: a log whose channels are not what their names say names no fault.
 
-use crate::log::{Column, Row};
+use crate::log::Row;
 
 /// Share of the alternating rows on which two channels must be equal to be duplicates.
 pub const DUPLICATE_SHARE: f64 = 0.5;

@@ -1,4 +1,5 @@
 use super::*;
+use crate::log::Column;
 use std::f64::consts::TAU;
 
 const RATE: f64 = 5000.0;
