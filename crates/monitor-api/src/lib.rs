@@ -15,8 +15,8 @@ use monitor_io::log::mapping::ColumnMapping;
 use monitor_io::log::OpenOptions;
 use monitor_io::params::{ParamError, ParamFile};
 use monitor_replay::{
-    diagnose_log, diagnose_log_fitted, HealthyReference, OptionError, OptionField, ReplayError, ReplayOptions,
-    UnbalanceBaseline,
+    diagnose_log, diagnose_log_fitted, HealthyReference, OptionError, OptionField, ReplayError,
+    ReplayOptions, UnbalanceBaseline,
 };
 use monitor_words::Spelling;
 use std::path::{Path, PathBuf};

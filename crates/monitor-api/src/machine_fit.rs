@@ -66,9 +66,9 @@ fn moves(rows: &[Row]) -> bool {
         .filter(|w| w.1 > 0)
         .map(|w| w.0 / f64::from(w.1))
         .collect();
-    let (lo, hi) = means
-        .iter()
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), m| (lo.min(*m), hi.max(*m)));
+    let (lo, hi) = means.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), m| {
+        (lo.min(*m), hi.max(*m))
+    });
     hi > MOVES_MIN * lo && lo > 0.0
 }
 
@@ -88,7 +88,8 @@ pub(crate) fn fit(params: &ParamFile, file: &LogFile) -> Option<MachineFit> {
     if !moves(&head.rows) {
         return None;
     }
-    let samples = Samples::from_rows(&head.rows, channels, f64::NEG_INFINITY, f64::INFINITY).ok()?;
+    let samples =
+        Samples::from_rows(&head.rows, channels, f64::NEG_INFINITY, f64::INFINITY).ok()?;
     let id = identify(params, &samples, &mut |_| {}).ok()?;
     let parameters = [
         FitParameter::Rs,

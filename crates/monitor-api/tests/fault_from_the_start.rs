@@ -17,7 +17,9 @@ use monitor_replay::{Detail, DiagnoseReport, Verdict};
 use std::path::Path;
 
 fn params(file: &str) -> String {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/params").join(file);
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/params")
+        .join(file);
     std::fs::read_to_string(p).expect("params") // ok: test
 }
 
@@ -65,22 +67,43 @@ fn a_fault_from_the_first_sample_is_named_or_not_called_healthy() {
             let n = r.verdict_finding.as_ref().and_then(|f| f.named().copied());
             assert_eq!(r.verdict, Verdict::Fault, "{motor} {kind}: {}", line(&r));
             let n = n.expect("named"); // ok: test
-            assert_eq!(n.fault, FaultName::Table1(fault), "{motor} {kind}: {}", line(&r));
+            assert_eq!(
+                n.fault,
+                FaultName::Table1(fault),
+                "{motor} {kind}: {}",
+                line(&r)
+            );
             let Size::Relative(size) = n.size else {
                 panic!("{n:?}"); // ok: test
             };
-            assert!((f64::from(size) - change).abs() < 0.03, "{motor} {kind}: {size}");
+            assert!(
+                (f64::from(size) - change).abs() < 0.03,
+                "{motor} {kind}: {size}"
+            );
             // Without the start, nothing to fit: never "healthy".
             let r = run(dir.path(), motor, Some((kind, change)), 2.0);
-            assert_ne!(r.verdict, Verdict::Healthy, "{motor} {kind} steady: {}", line(&r));
+            assert_ne!(
+                r.verdict,
+                Verdict::Healthy,
+                "{motor} {kind} steady: {}",
+                line(&r)
+            );
         }
         let r = run(dir.path(), motor, None, 0.0);
         assert_eq!(r.verdict, Verdict::Healthy, "{motor} healthy: {}", line(&r));
-        let fitted = r.findings.iter().any(|f| matches!(&f.detail, Detail::MachineFit(m) if m.on_file()));
+        let fitted = r
+            .findings
+            .iter()
+            .any(|f| matches!(&f.detail, Detail::MachineFit(m) if m.on_file()));
         assert!(fitted, "{motor}: {:?}", r.findings);
         assert!(line(&r).contains("reach"), "{}", line(&r));
         let r = run(dir.path(), motor, None, 2.0);
-        assert_eq!(r.verdict, Verdict::Healthy, "{motor} healthy steady: {}", line(&r));
+        assert_eq!(
+            r.verdict,
+            Verdict::Healthy,
+            "{motor} healthy steady: {}",
+            line(&r)
+        );
         assert!(line(&r).contains("reach"), "{}", line(&r));
     }
 }

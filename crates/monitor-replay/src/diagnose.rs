@@ -102,9 +102,15 @@ pub fn diagnose_log_fitted(
     progress: &mut dyn FnMut(f64),
 ) -> Result<Diagnosed, ReplayError> {
     let mut bar = Forward::new(progress);
-    let d = replay_observed(params, file.channels(), file.shown(), opts, None, fit, |stage| {
-        read_counted(file, stage, &mut bar)
-    });
+    let d = replay_observed(
+        params,
+        file.channels(),
+        file.shown(),
+        opts,
+        None,
+        fit,
+        |stage| read_counted(file, stage, &mut bar),
+    );
     if d.is_ok() {
         bar.to(1.0);
     }

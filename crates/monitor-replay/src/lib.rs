@@ -57,7 +57,8 @@ pub use verdict::{MIN_FAULT_CHANGE, MIN_JUDGED_S};
 pub use windows::SENSOR_PHASE_MIN_RATIO;
 
 pub use diagnose::{
-    diagnose_file, diagnose_file_observed, diagnose_log, diagnose_log_fitted, diagnose_rows, Diagnosed,
+    diagnose_file, diagnose_file_observed, diagnose_log, diagnose_log_fitted, diagnose_rows,
+    Diagnosed,
 };
 pub use events::{IsolationEvent, LOAD_MOVE_FRACTION, MAX_EVENTS};
 pub use isolation::said::{

@@ -64,8 +64,10 @@ pub(crate) fn isolation_name(
 /// for and heating does not explain.
 fn deviates_unexplained(iso: &IsolationReport) -> bool {
     use monitor_core::IsolationState;
-    matches!(iso.state, IsolationState::Isolated | IsolationState::Unknown)
-        && iso.named.is_none()
+    matches!(
+        iso.state,
+        IsolationState::Isolated | IsolationState::Unknown
+    ) && iso.named.is_none()
         && !iso.heating_explains
 }
 

@@ -10,8 +10,8 @@
 
 mod commissioning;
 mod findings;
-mod machine_fit;
 mod isolation;
+mod machine_fit;
 mod named;
 mod rotor;
 mod verdict;
