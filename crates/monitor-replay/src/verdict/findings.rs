@@ -310,7 +310,13 @@ impl Stages<'_> {
         let outside = self.lamps.commission.moved_note(out);
         let rise_k = iso.winding_rise_k;
         if outside.is_none() && load_moves == 0 && rise_k.is_none() {
-            return of(State::Clear, Detail::Steady);
+            // "No heating" only where the isolation read the windings at a steady point.
+            let detail = if iso.state == monitor_core::IsolationState::NotJudged {
+                Detail::NoLoadMoveHeatingUnread
+            } else {
+                Detail::Steady
+            };
+            return of(State::Clear, detail);
         }
         of(
             State::Explained,

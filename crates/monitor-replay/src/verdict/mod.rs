@@ -89,6 +89,9 @@ pub enum Detail {
     OperatingPointUnavailable,
     /// Steady: no load move, no heating.
     Steady,
+    /// No load move; the heating not judged: the isolation never judged a steady
+    /// operating point with voltage, so the windings' temperature was not read.
+    NoLoadMoveHeatingUnread,
     /// The operating point moved.
     OperatingPointMoved {
         /// Outside the commissioned range at the end: what left it.

@@ -53,6 +53,9 @@ fn summary_of(detail: &Detail, rep: &DiagnoseReport, sp: &dyn Spelling) -> Strin
             "the load and the heating need the voltages and the speed".into()
         }
         Detail::Steady => "steady: no load move, no heating".into(),
+        Detail::NoLoadMoveHeatingUnread => {
+            "no load move; the heating not read (no steady operating point with voltage was judged)".into()
+        }
         Detail::OperatingPointMoved {
             outside,
             load_moves,
@@ -72,9 +75,11 @@ fn summary_of(detail: &Detail, rep: &DiagnoseReport, sp: &dyn Spelling) -> Strin
                 ));
             }
             if let Some(rise) = rise_k {
-                said.push(format!(
-                    "the windings warmed by {rise:.0} K since commissioning"
-                ));
+                said.push(if commissioned(rep) {
+                    format!("the windings warmed by {rise:.0} K since commissioning")
+                } else {
+                    format!("the windings are about {rise:.0} K warmer than the parameter file assumes")
+                });
             }
             said.join("; ")
         }
@@ -136,6 +141,14 @@ fn summary_of(detail: &Detail, rep: &DiagnoseReport, sp: &dyn Spelling) -> Strin
     }
 }
 
+/// Whether the residuals were judged against a commissioned baseline.
+fn commissioned(rep: &DiagnoseReport) -> bool {
+    rep.findings.iter().any(|f| {
+        f.source() == FindingSource::Residuals
+            && f.finding.against == monitor_core::verdict::Against::Commissioning
+    })
+}
+
 /// Why the parameter file does not fit the log.
 fn file_misfit(m: &FileMisfit, rep: &DiagnoseReport, sp: &dyn Spelling) -> String {
     let within = |n: &NamedFault| {
@@ -187,9 +200,10 @@ pub fn brief(f: &FindingReport, rep: &DiagnoseReport, sp: &dyn Spelling) -> Stri
         Detail::LampsOutOfRange { .. } => residuals(),
         Detail::Winding => winding::brief(&rep.unbalance, against, sp),
         Detail::Rotor => rotor::brief(&rep.rotor),
-        Detail::OperatingPointUnavailable | Detail::Steady | Detail::OperatingPointMoved { .. } => {
-            "operating point".into()
-        }
+        Detail::OperatingPointUnavailable
+        | Detail::Steady
+        | Detail::NoLoadMoveHeatingUnread
+        | Detail::OperatingPointMoved { .. } => "operating point".into(),
         Detail::Commissioned
         | Detail::ParameterFitUnavailable
         | Detail::FileFits

@@ -197,16 +197,11 @@ fn events_list(h: &mut String, rep: &DiagnoseReport) {
         .iter()
         .map(|e| (e.t_s(), words::event_line(e).trim().to_string()))
         .collect();
-    lines.extend(rep.detections.iter().map(|d| {
-        (
-            d.t_s,
-            format!(
-                "{:.2} s  the lamps' signature first matched {} (the verdict above weighs it)",
-                d.t_s,
-                d.fault.name()
-            ),
-        )
-    }));
+    lines.extend(
+        rep.detections
+            .iter()
+            .map(|d| (d.t_s, words::detection_line(d, rep))),
+    );
     lines.sort_by(|a, b| a.0.total_cmp(&b.0));
     let lines: Vec<String> = lines.into_iter().map(|(_, l)| l).collect();
     list(h, "Events (marked on the charts above)", &lines);
