@@ -199,6 +199,12 @@ fn table(id: &Identification) -> String {
     if let Some(g) = &id.inverse_gamma {
         s.push_str(&format!("{}\n", identify::inverse_gamma_line("", g)));
     }
+    if let Some(l) = &id.supply_from_log {
+        s.push_str(&format!(
+            "{}\n",
+            monitor_api::words::identify::supply_from_log(l)
+        ));
+    }
     s.push_str(&format!(
         "(the full-order model over {:.3}..{:.3} s, a start or steps included; compare and explain judge the paper's steady-state model: leave a start out there with --from, as compare's advice says)\n",
         id.window_s.0, id.window_s.1
