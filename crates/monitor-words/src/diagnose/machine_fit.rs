@@ -39,44 +39,62 @@ pub(super) fn summary(f: &MachineFit) -> String {
     }
 }
 
-/// The residuals' reach on this log, in brackets after "residuals against ...": against
-/// commissioning, the largest of the isolation's detection limits (the smallest change of
-/// each fault it names at the commissioned point); against the file, how far the machine
-/// fitted to the log is the file's, or that a fault present from the start shows only as
-/// far as the file is the machine's.
+/// The residuals' reach on this log, in brackets after "residuals against ..." (nothing
+/// where there is none to say): [`reach_text`].
 pub(super) fn reach(rep: &DiagnoseReport, against: Against) -> String {
+    reach_text(rep, against).map_or(String::new(), |r| format!(" (reach: {r})"))
+}
+
+/// The residuals' reach on this log: against commissioning, the largest of the
+/// isolation's detection limits (the smallest change of each fault it names at the
+/// commissioned point); against the file, how far the machine fitted to the log is the
+/// file's, or that a fault present from the start shows only as far as the file is the
+/// machine's. `None` against anything else, or without detection limits.
+pub fn reach_text(rep: &DiagnoseReport, against: Against) -> Option<String> {
     match against {
         Against::Commissioning => {
             let mut limits = rep.isolation.detection_limits.clone();
             limits.sort_by(|a, b| b.change.total_cmp(&a.change));
-            match limits.first() {
-                Some(l) => format!(
-                    " (reach: a fault named from {} in {}, less in the others)",
+            limits.first().map(|l| {
+                format!(
+                    "a fault named from {} in {}, less in the others",
                     pct(l.change).trim_start_matches('+'),
                     l.fault.name()
-                ),
-                None => String::new(),
-            }
+                )
+            })
         }
         Against::ParameterFile => {
             let fit = rep.findings.iter().find_map(|f| match &f.detail {
                 Detail::MachineFit(m) if f.source() == FindingSource::ParameterFit => Some(m),
                 _ => None,
             });
-            match fit.filter(|m| m.on_file()) {
+            Some(match fit.filter(|m| m.on_file()) {
                 Some(m) => {
                     let widest = m.changes.iter().map(|c| c.reach()).fold(0.0f32, f32::max);
                     format!(
-                        " (reach: the machine fitted to the log's start is the file's within {}: a fault present from the start beyond that would show)",
+                        "the machine fitted to the log's start is the file's within {}: a fault present from the start beyond that would show",
                         pct(widest).trim_start_matches('+')
                     )
                 }
                 None => format!(
-                    " (reach: a fault present from the start within +/-{:.0} % of the file's values is not told from the file's own error; commission, or log a start)",
+                    "a fault present from the start within +/-{:.0} % of the file's values is not told from the file's own error; commission, or log a start",
                     100.0 * NOMINAL_UNCERTAINTY
                 ),
-            }
+            })
         }
-        _ => String::new(),
+        _ => None,
     }
+}
+
+/// What a healthy verdict could not see on this log, for a fleet's row: the residuals'
+/// reach ([`reach_text`]) where the verdict is healthy, else `None`.
+pub fn not_seen(rep: &DiagnoseReport) -> Option<String> {
+    if rep.verdict != monitor_replay::Verdict::Healthy {
+        return None;
+    }
+    let residuals = rep
+        .findings
+        .iter()
+        .find(|f| f.source() == FindingSource::Residuals && !f.judged_nothing())?;
+    reach_text(rep, residuals.finding.against)
 }

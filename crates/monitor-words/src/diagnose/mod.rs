@@ -11,7 +11,7 @@
 mod commissioning;
 mod findings;
 mod isolation;
-mod machine_fit;
+pub mod machine_fit;
 mod named;
 mod rotor;
 mod verdict;
