@@ -73,6 +73,11 @@ pub struct DiagnoseReport {
     pub max_abs_residual: [f32; 4],
     /// Timeline (one point per `timeline_step_s`).
     pub timeline: Vec<TimelinePoint>,
+    /// The threshold band of each normalised residual r1..r4 in force at the log's end,
+    /// `[centre, half-width]` (the learned mean and `k_sigma` spreads once commissioned
+    /// (in force from the commissioning window's end), else 0 and the fixed threshold): a
+    /// residual outside its band lights its lamp. Null for a log without the residuals.
+    pub threshold_bands: Option<[[f32; 2]; 4]>,
 }
 
 /// The final lamps' matching against the signature matrix: the faults with a probability,
@@ -143,6 +148,7 @@ impl DiagnoseReport {
             rows,
             max_abs_residual: lamps.max_abs,
             timeline,
+            threshold_bands: None,
         }
     }
 

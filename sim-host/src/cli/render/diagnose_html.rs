@@ -356,6 +356,7 @@ fn residuals_chart(rep: &DiagnoseReport) -> Chart<'static> {
             line(&format!("r{}", k + 1), pts, k, false)
         })
         .collect();
+    series.extend(threshold_lines(rep));
     let hi = series
         .iter()
         .flat_map(|s| s.points.iter().map(|p| p.1.abs()))
@@ -366,11 +367,50 @@ fn residuals_chart(rep: &DiagnoseReport) -> Chart<'static> {
         rep,
         (
             "residuals",
-            "Residuals r1..r4 over time, events marked",
+            "Residuals r1..r4 over time with their threshold bands (dashed), events marked",
             "residual [% of nominal]",
         ),
         series,
     )
+}
+
+/// Each residual's threshold band in force at the log's end (`threshold_bands`), dashed in
+/// its residual's colour: its two edges from where it came into force (the commissioning
+/// window's end, else the log's first point) to the log's end. A residual outside its band
+/// lights its lamp: the chart shows why r1 lit and r2 did not.
+fn threshold_lines(rep: &DiagnoseReport) -> Vec<Series> {
+    let (Some(bands), Some(first), Some(last)) = (
+        rep.threshold_bands,
+        rep.timeline.first(),
+        rep.timeline.last(),
+    ) else {
+        return Vec::new();
+    };
+    let from = rep
+        .commissioning
+        .window
+        .filter(|_| {
+            matches!(
+                rep.commissioning.thresholds,
+                monitor_api::replay::Thresholds::Learned { .. }
+            )
+        })
+        .map_or(first.t_s, |w| w[1].max(first.t_s));
+    bands
+        .iter()
+        .enumerate()
+        .map(|(k, [c, w])| {
+            let (lo, hi) = (100.0 * f64::from(c - w), 100.0 * f64::from(c + w));
+            let pts = vec![
+                (from, lo),
+                (last.t_s, lo),
+                (f64::NAN, f64::NAN),
+                (from, hi),
+                (last.t_s, hi),
+            ];
+            line(&format!("r{} band", k + 1), pts, k, true)
+        })
+        .collect()
 }
 
 /// The lamps r1..r4 and the monitor's state over time: one row each, high where lit.

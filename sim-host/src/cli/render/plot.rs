@@ -197,11 +197,12 @@ fn log_tick(v: &f64) -> String {
 
 /// Where the legend goes: the corner of the plot (or the right's middle) the series cross
 /// least, counted on their points and, for lines, on points along their segments, in the
-/// plot's own scale (`log_y`: the logarithm's) within `ranges`.
+/// plot's own scale (`log_y`: the logarithm's) within `ranges`; and how many points cross
+/// it.
 fn legend_position(
     c: &Chart,
     ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
-) -> SeriesLabelPosition {
+) -> (SeriesLabelPosition, usize) {
     let ty = |y: f64| {
         if c.log_y {
             y.max(f64::MIN_POSITIVE).log10()
@@ -250,10 +251,48 @@ fn legend_position(
         }
     }
     let best = (0..boxes.len()).min_by_key(|&k| counts[k]).unwrap_or(0);
-    boxes
-        .into_iter()
-        .nth(best)
-        .map_or(SeriesLabelPosition::UpperRight, |b| b.0)
+    (
+        boxes
+            .into_iter()
+            .nth(best)
+            .map_or(SeriesLabelPosition::UpperRight, |b| b.0),
+        counts[best],
+    )
+}
+
+/// Height of one legend entry [px] and the legend box's margins, as plotters draws them
+/// at the legend's font (about).
+const LEGEND_ROW_PX: f64 = 20.0;
+/// The plot's own height within the chart [px]: the chart's less its caption, its x
+/// labels and its margins (about).
+const PLOT_PX: f64 = HEIGHT_PX as f64 - 110.0;
+
+/// Where the legend goes and the y range that leaves it room: the corner the series cross
+/// least ([`legend_position`]) where none crosses it; else the upper right, over headroom
+/// added above the data as tall as the legend (its entries, [`LEGEND_ROW_PX`] each), so
+/// that the legend never covers data (on the rotor's, the lamps' and the residuals' charts
+/// it did where every corner held some). Without text, no legend: the ranges as they are.
+fn room_for_the_legend(
+    c: &Chart,
+    ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
+    text: bool,
+) -> (SeriesLabelPosition, (f64, f64)) {
+    let (corner, crossing) = legend_position(c, ((x0, x1), (y0, y1)));
+    let rows = legend(c).len() as f64;
+    // The legend's share of the plot's height, and a little more.
+    let share = ((rows * LEGEND_ROW_PX + 16.0) / PLOT_PX).min(0.8) + 0.03;
+    // (A corner's box is 35 % of the plot's height: a taller legend gets the headroom.)
+    if !text || rows == 0.0 || (crossing == 0 && share <= 0.35) {
+        return (corner, (y0, y1));
+    }
+    let grow = 1.0 / (1.0 - share);
+    let y1 = if c.log_y {
+        let (l0, l1) = (y0.max(f64::MIN_POSITIVE).log10(), y1.log10());
+        10f64.powf(l0 + (l1 - l0) * grow)
+    } else {
+        y0 + (y1 - y0) * grow
+    };
+    (SeriesLabelPosition::UpperRight, (y0, y1))
 }
 
 /// DejaVu Sans 2.37 (Bitstream Vera licence: `assets/fonts/LICENSE-DejaVu.txt`), the PNG
@@ -374,6 +413,7 @@ where
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     root.fill(&WHITE).map_err(e)?;
     let ((x0, x1), (y0, y1)) = ranges(c);
+    let (corner, (y0, y1)) = room_for_the_legend(c, ((x0, x1), (y0, y1)), text);
     let mut b = ChartBuilder::on(&root);
     b.margin(12);
     if text {
@@ -381,7 +421,6 @@ where
             .x_label_area_size(40 + upright_names_px(c))
             .y_label_area_size(70);
     }
-    let corner = legend_position(c, ((x0, x1), (y0, y1)));
     let ticks = if c.log_y {
         let chart = b
             .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
