@@ -124,6 +124,7 @@ pub fn run(args: &IdentifyArgs) -> anyhow::Result<()> {
         });
         writeln!(stdout, "{}", serde_json::to_string_pretty(&doc)?)?;
     } else {
+        let mut stdout = super::out::text();
         write!(stdout, "{}", table(id))?;
         match &args.out {
             Some(out) => writeln!(stdout, "wrote {}", out.display())?,

@@ -122,7 +122,7 @@ pub fn run(args: &TrendArgs) -> anyhow::Result<()> {
             },
         );
     }
-    let mut out = super::out::stdout();
+    let mut out = super::out::text();
     print_table(&mut out, &motors, args.motor.is_some())?;
     Ok(())
 }
