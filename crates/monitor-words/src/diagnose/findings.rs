@@ -92,8 +92,8 @@ fn summary_of(detail: &Detail, rep: &DiagnoseReport, sp: &dyn Spelling) -> Strin
                 .into()
         }
         Detail::FileMisfit(m) => format!(
-            "the log departs from the parameter file: a file off the machine, or a fault present from the start, \
-             look the same here (commission on the healthy motor, or identify it from a healthy log): {}",
+            "the parameter file does not fit this log, or a fault was there from its start: the two look the same here \
+             (commission on the healthy motor, or identify it from a healthy log): {}",
             file_misfit(m, rep, sp)
         ),
         Detail::MachineFit(f) => super::machine_fit::summary(f),

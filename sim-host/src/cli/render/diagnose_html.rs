@@ -374,16 +374,15 @@ fn residuals_chart(rep: &DiagnoseReport) -> Chart<'static> {
     )
 }
 
-/// Each residual's threshold band in force at the log's end (`threshold_bands`), dashed in
-/// its residual's colour: its two edges from where it came into force (the commissioning
-/// window's end, else the log's first point) to the log's end. A residual outside its band
-/// lights its lamp: the chart shows why r1 lit and r2 did not.
+/// The residuals' threshold bands in force at the log's end (`threshold_bands`), dashed in
+/// grey (one legend entry, a colour of its own): each band's two edges from where it came
+/// into force (the commissioning window's end, else the log's first point) to the log's
+/// end. A residual outside its band lights its lamp: the chart shows why r1 lit and r2 did
+/// not (the fixed bands are one, +/-3 %; the learned ones each residual's own).
 fn threshold_lines(rep: &DiagnoseReport) -> Vec<Series> {
-    let (Some(bands), Some(first), Some(last)) = (
-        rep.threshold_bands,
-        rep.timeline.first(),
-        rep.timeline.last(),
-    ) else {
+    let (Some(bands), Some(first), Some(last)) =
+        (rep.threshold_bands, rep.timeline.first(), rep.timeline.last())
+    else {
         return Vec::new();
     };
     let from = rep
@@ -396,21 +395,14 @@ fn threshold_lines(rep: &DiagnoseReport) -> Vec<Series> {
             )
         })
         .map_or(first.t_s, |w| w[1].max(first.t_s));
-    bands
-        .iter()
-        .enumerate()
-        .map(|(k, [c, w])| {
-            let (lo, hi) = (100.0 * f64::from(c - w), 100.0 * f64::from(c + w));
-            let pts = vec![
-                (from, lo),
-                (last.t_s, lo),
-                (f64::NAN, f64::NAN),
-                (from, hi),
-                (last.t_s, hi),
-            ];
-            line(&format!("r{} band", k + 1), pts, k, true)
-        })
-        .collect()
+    let mut pts = Vec::new();
+    for [c, w] in bands {
+        for edge in [c - w, c + w] {
+            let y = 100.0 * f64::from(edge);
+            pts.extend([(from, y), (last.t_s, y), (f64::NAN, f64::NAN)]);
+        }
+    }
+    vec![line("threshold bands r1..r4", pts, 5, true)]
 }
 
 /// The lamps r1..r4 and the monitor's state over time: one row each, high where lit.

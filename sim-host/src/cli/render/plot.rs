@@ -271,7 +271,8 @@ const PLOT_PX: f64 = HEIGHT_PX as f64 - 110.0;
 /// least ([`legend_position`]) where none crosses it; else the upper right, over headroom
 /// added above the data as tall as the legend (its entries, [`LEGEND_ROW_PX`] each), so
 /// that the legend never covers data (on the rotor's, the lamps' and the residuals' charts
-/// it did where every corner held some). Without text, no legend: the ranges as they are.
+/// it did where every corner held some). Without text, no legend: the ranges as they are;
+/// a logarithmic y axis keeps its range (the corner the series cross least).
 fn room_for_the_legend(
     c: &Chart,
     ((x0, x1), (y0, y1)): ((f64, f64), (f64, f64)),
@@ -282,17 +283,13 @@ fn room_for_the_legend(
     // The legend's share of the plot's height, and a little more.
     let share = ((rows * LEGEND_ROW_PX + 16.0) / PLOT_PX).min(0.8) + 0.03;
     // (A corner's box is 35 % of the plot's height: a taller legend gets the headroom.)
-    if !text || rows == 0.0 || (crossing == 0 && share <= 0.35) {
+    // (Linear y axes only: a logarithmic one's decades are the reader's scale, not to be
+    // stretched.)
+    if !text || c.log_y || rows == 0.0 || (crossing == 0 && share <= 0.35) {
         return (corner, (y0, y1));
     }
     let grow = 1.0 / (1.0 - share);
-    let y1 = if c.log_y {
-        let (l0, l1) = (y0.max(f64::MIN_POSITIVE).log10(), y1.log10());
-        10f64.powf(l0 + (l1 - l0) * grow)
-    } else {
-        y0 + (y1 - y0) * grow
-    };
-    (SeriesLabelPosition::UpperRight, (y0, y1))
+    (SeriesLabelPosition::UpperRight, (y0, y0 + (y1 - y0) * grow))
 }
 
 /// DejaVu Sans 2.37 (Bitstream Vera licence: `assets/fonts/LICENSE-DejaVu.txt`), the PNG
