@@ -28,8 +28,9 @@ Errors
     is also a ``ValueError`` and a value of the wrong type a ``TypeError``
     (:class:`OptionTypeError`, :class:`ParamsTypeError`, :class:`LogTypeError`:
     ``parallel_paths=2.5``, ``from_s="1.5"``), so ``except ValueError`` and ``except
-    TypeError`` catch them; a bug is also a ``RuntimeError``. No Rust panic crosses into
-    Python.
+    TypeError`` catch them; a file that does not exist is also a ``FileNotFoundError``
+    (:class:`LogNotFoundError`, :class:`ParamsNotFoundError`); a bug is also a
+    ``RuntimeError``. No Rust panic crosses into Python.
     The GIL is released while the library runs, so threads (and Dask) run in parallel.
 
 The fleet run over many motors' logs on Dask is :func:`drive_monitor.fleet.diagnose_many`;
@@ -65,10 +66,12 @@ from ._errors import (
     DriveMonitorError,
     InternalError,
     LogError,
+    LogNotFoundError,
     LogTypeError,
     OptionError,
     OptionTypeError,
     ParamsError,
+    ParamsNotFoundError,
     ParamsTypeError,
 )
 from .history import Trend, trend
@@ -107,6 +110,8 @@ __all__ = [
     "ParamsTypeError",
     "LogError",
     "LogTypeError",
+    "LogNotFoundError",
+    "ParamsNotFoundError",
     "OptionError",
     "OptionTypeError",
     "AnalysisError",
@@ -266,7 +271,9 @@ def diagnose(
     Raises
     ------
     ParamsError, LogError, OptionError, AnalysisError
-        A bad value (each also a ``ValueError``).
+        A bad value (each also a ``ValueError``); a file that does not exist is a
+        :class:`LogNotFoundError` or :class:`ParamsNotFoundError` (also a
+        ``FileNotFoundError``).
     OptionTypeError, ParamsTypeError, LogTypeError
         A value of the wrong type (each also a ``TypeError``): ``parallel_paths=2.5``.
     """

@@ -8,6 +8,9 @@ classes (``pyo3::import_exception!`` in ``python/src/lib.rs``); ``drive_monitor`
 - :class:`ParamsError`, :class:`LogError`, :class:`OptionError`, :class:`AnalysisError`:
   a bad value (a parameter file's, a log's, an option's content, a log the analysis cannot
   run on), so also ``ValueError``.
+- :class:`ParamsNotFoundError`, :class:`LogNotFoundError`: the parameter file or the log
+  does not exist, so also ``FileNotFoundError`` (``except FileNotFoundError`` catches a
+  missing file, as Python's own ``open`` raises it; ``except LogError`` still does).
 - :class:`ParamsTypeError`, :class:`LogTypeError`, :class:`OptionTypeError`: the same
   errors for a value of the wrong type (``parallel_paths=2.5``, ``from_s="1.5"``, a log that
   is a number), so also ``TypeError``; ``except OptionError`` still catches them.
@@ -22,6 +25,8 @@ __all__ = [
     "ParamsTypeError",
     "LogError",
     "LogTypeError",
+    "ParamsNotFoundError",
+    "LogNotFoundError",
     "OptionError",
     "OptionTypeError",
     "AnalysisError",
@@ -49,6 +54,18 @@ class ParamsTypeError(ParamsError, TypeError):
 
 class LogError(DriveMonitorError, ValueError):
     """The log cannot be read, or is not one (a bad value: also a ValueError)."""
+
+    __module__ = "drive_monitor"
+
+
+class ParamsNotFoundError(ParamsError, FileNotFoundError):
+    """The parameter file does not exist (also a FileNotFoundError)."""
+
+    __module__ = "drive_monitor"
+
+
+class LogNotFoundError(LogError, FileNotFoundError):
+    """The log file does not exist (also a FileNotFoundError)."""
 
     __module__ = "drive_monitor"
 

@@ -15,10 +15,12 @@ from ._errors import AnalysisError as AnalysisError
 from ._errors import DriveMonitorError as DriveMonitorError
 from ._errors import InternalError as InternalError
 from ._errors import LogError as LogError
+from ._errors import LogNotFoundError as LogNotFoundError
 from ._errors import LogTypeError as LogTypeError
 from ._errors import OptionError as OptionError
 from ._errors import OptionTypeError as OptionTypeError
 from ._errors import ParamsError as ParamsError
+from ._errors import ParamsNotFoundError as ParamsNotFoundError
 from ._errors import ParamsTypeError as ParamsTypeError
 
 def diagnose(

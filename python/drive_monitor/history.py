@@ -99,7 +99,7 @@ def trend(
         The baseline: each motor's logs up to the end of this UTC day (``YYYY-MM-DD``) are
         its reference (the bands, the scatters from the reference, the alarm's clearing),
         as ``sim-host trend --reference-until``. Default: each motor's first
-        ``window_days`` of logs whose verdict is not FAULT.
+        ``window_days`` of logs whose verdict is healthy or watching.
 
     Raises
     ------

@@ -32,6 +32,8 @@ pyo3::import_exception!(drive_monitor._errors, ParamsError);
 pyo3::import_exception!(drive_monitor._errors, ParamsTypeError);
 pyo3::import_exception!(drive_monitor._errors, LogError);
 pyo3::import_exception!(drive_monitor._errors, LogTypeError);
+pyo3::import_exception!(drive_monitor._errors, LogNotFoundError);
+pyo3::import_exception!(drive_monitor._errors, ParamsNotFoundError);
 pyo3::import_exception!(drive_monitor._errors, OptionError);
 pyo3::import_exception!(drive_monitor._errors, OptionTypeError);
 pyo3::import_exception!(drive_monitor._errors, AnalysisError);
@@ -91,6 +93,12 @@ fn to_py(e: ApiError) -> PyErr {
     let msg = e.spelled(&PyWords);
     if let ApiError::Laws(monitor_api::laws::LawError::NotFound { .. }) = e {
         return pyo3::exceptions::PyFileNotFoundError::new_err(msg);
+    }
+    // A file that does not exist is also Python's FileNotFoundError.
+    match (e.kind(), e.is_not_found()) {
+        (ErrorKind::Params, true) => return ParamsNotFoundError::new_err(msg),
+        (ErrorKind::Log, true) => return LogNotFoundError::new_err(msg),
+        _ => {}
     }
     match e.kind() {
         ErrorKind::Params => ParamsError::new_err(msg),
@@ -468,6 +476,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ParamsTypeError", py.get_type::<ParamsTypeError>())?;
     m.add("LogError", py.get_type::<LogError>())?;
     m.add("LogTypeError", py.get_type::<LogTypeError>())?;
+    m.add("LogNotFoundError", py.get_type::<LogNotFoundError>())?;
+    m.add("ParamsNotFoundError", py.get_type::<ParamsNotFoundError>())?;
     m.add("OptionError", py.get_type::<OptionError>())?;
     m.add("OptionTypeError", py.get_type::<OptionTypeError>())?;
     m.add("AnalysisError", py.get_type::<AnalysisError>())?;

@@ -114,6 +114,20 @@ def test_a_bad_value_is_a_value_error(repo, call, kind, says):
         pytest.fail("no error")
 
 
+@pytest.mark.parametrize("call, kind", [
+    (lambda r: dm.diagnose(r / "nosuch.csv", r / MOTULATOR_P), dm.LogNotFoundError),
+    (lambda r: dm.identify(r / "nosuch.csv", r / MOTULATOR_P), dm.LogNotFoundError),
+    (lambda r: dm.diagnose(r / MOTULATOR, r / "nosuch.toml"), dm.ParamsNotFoundError),
+])
+def test_a_missing_file_is_a_file_not_found_error(repo, call, kind):
+    # Python's convention for a file that is not there (issue 86): FileNotFoundError, as
+    # open() raises; still the package's LogError / ParamsError, so also a ValueError.
+    with pytest.raises(FileNotFoundError) as e:
+        call(repo)
+    assert isinstance(e.value, kind) and isinstance(e.value, ValueError), type(e.value)
+    assert "nosuch" in str(e.value)
+
+
 def test_a_glob_that_matches_nothing_is_a_value_error(tmp_path, repo):
     with pytest.raises(ValueError, match="matches no file") as e:
         fleet.diagnose_many(str(tmp_path / "none_*.csv"), [{"name": "m", "params": str(repo / MOTULATOR_P),

@@ -83,7 +83,7 @@ fn demo_names_the_injected_fault() {
     assert!(before.iter().all(|l| !l.contains("FAULT")), "{text}");
     assert!(before.iter().any(|l| l.contains("MOVED")), "{text}");
     assert_eq!(text.matches("event: ").count(), 2, "{text}");
-    let last = text.lines().last().unwrap_or_default();
+    let last = verdict_line_of(&text);
     assert!(last.starts_with("verdict: FAULT rs +"), "{last}");
     // The paper's case, one option away: Bl +50 % on its fixed viscous load, the amber
     // state with the friction class and the sentence why.
@@ -405,4 +405,21 @@ fn every_command_has_a_help_that_teaches() {
             "{cmd} --help shows no example command line:\n{text}"
         );
     }
+}
+
+/// The text's verdict line as one line: the line that starts with `verdict: ` and the lines
+/// it was wrapped onto (indented by four spaces: the text output wraps at 160 characters).
+fn verdict_line_of(text: &str) -> String {
+    let mut lines = text.lines().skip_while(|l| !l.starts_with("verdict: "));
+    let Some(first) = lines.next() else {
+        return String::new();
+    };
+    std::iter::once(first.to_string())
+        .chain(
+            lines
+                .take_while(|l| l.starts_with("    "))
+                .map(|l| l.trim_start().to_string()),
+        )
+        .collect::<Vec<_>>()
+        .join(" ")
 }

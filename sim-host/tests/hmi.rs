@@ -117,9 +117,9 @@ fn a_log_replay_takes_diagnoses_options_and_refuses_what_it_refuses() {
         "{out}"
     );
     let d = run("diagnose", &extra);
-    let line = String::from_utf8_lossy(&d.stdout)
-        .lines()
-        .find_map(|l| l.strip_prefix("verdict: ").map(str::to_string))
+    let line = verdict_line_of(&String::from_utf8_lossy(&d.stdout))
+        .strip_prefix("verdict: ")
+        .map(str::to_string)
         .expect("diagnose's verdict line");
     assert!(out.contains(&format!("> verdict: {line}")), "{line}\n{out}");
     // Without the baseline: judged against the log's own stretches.
@@ -153,4 +153,21 @@ fn a_log_replay_takes_diagnoses_options_and_refuses_what_it_refuses() {
         assert!(first(&h).contains(bad[0]), "{bad:?}: {}", first(&h));
         assert!(!first(&h).contains("Usage"), "{bad:?}: {}", first(&h));
     }
+}
+
+/// The text's verdict line as one line: the line that starts with `verdict: ` and the lines
+/// it was wrapped onto (indented by four spaces: the text output wraps at 160 characters).
+fn verdict_line_of(text: &str) -> String {
+    let mut lines = text.lines().skip_while(|l| !l.starts_with("verdict: "));
+    let Some(first) = lines.next() else {
+        return String::new();
+    };
+    std::iter::once(first.to_string())
+        .chain(
+            lines
+                .take_while(|l| l.starts_with("    "))
+                .map(|l| l.trim_start().to_string()),
+        )
+        .collect::<Vec<_>>()
+        .join(" ")
 }

@@ -232,7 +232,8 @@ fn a_fault_verdict_beside_dark_lamps_says_why() {
         "2:3.5",
     ]);
     let dark = text.contains("\nfinal lamps: none\n") && text.contains("\ncandidates: none\n");
-    let verdict = text.lines().last().unwrap_or_default();
+    let verdict = verdict_line_of(&text);
+    let verdict = verdict.as_str();
     assert!(
         !(dark && verdict == "verdict: FAULT"),
         "a bare FAULT beside dark lamps and no candidate:\n{text}"
@@ -248,4 +249,21 @@ fn a_fault_verdict_beside_dark_lamps_says_why() {
         verdict.starts_with("verdict: healthy") && verdict.contains("lamps lit for a load move"),
         "{verdict}"
     );
+}
+
+/// The text's verdict line as one line: the line that starts with `verdict: ` and the lines
+/// it was wrapped onto (indented by four spaces: the text output wraps at 160 characters).
+fn verdict_line_of(text: &str) -> String {
+    let mut lines = text.lines().skip_while(|l| !l.starts_with("verdict: "));
+    let Some(first) = lines.next() else {
+        return String::new();
+    };
+    std::iter::once(first.to_string())
+        .chain(
+            lines
+                .take_while(|l| l.starts_with("    "))
+                .map(|l| l.trim_start().to_string()),
+        )
+        .collect::<Vec<_>>()
+        .join(" ")
 }

@@ -222,7 +222,8 @@ fn contradictions(d: &Value, text: &str) -> Vec<String> {
     let verdict = d["verdict"].as_str().unwrap_or("");
     let line = d["verdict_line"].as_str().unwrap_or("");
     let findings = d["findings"].as_array().cloned().unwrap_or_default();
-    let last = text.lines().last().unwrap_or("");
+    let last = verdict_line_of(text);
+    let last = last.as_str();
     if last != format!("verdict: {line}") {
         bad.push(format!(
             "the text's last line {last:?} is not the JSON's verdict line {line:?}"
@@ -503,4 +504,21 @@ fn the_checks_catch_the_contradictions_the_issue_measured() {
         other_stories(&current_only, "thresholds: fixed: |r| > 3.0 %\n").len(),
         2
     );
+}
+
+/// The text's verdict line as one line: the line that starts with `verdict: ` and the lines
+/// it was wrapped onto (indented by four spaces: the text output wraps at 160 characters).
+fn verdict_line_of(text: &str) -> String {
+    let mut lines = text.lines().skip_while(|l| !l.starts_with("verdict: "));
+    let Some(first) = lines.next() else {
+        return String::new();
+    };
+    std::iter::once(first.to_string())
+        .chain(
+            lines
+                .take_while(|l| l.starts_with("    "))
+                .map(|l| l.trim_start().to_string()),
+        )
+        .collect::<Vec<_>>()
+        .join(" ")
 }

@@ -436,7 +436,8 @@ impl Analysis {
             .iter()
             .zip(&f.effect_params)
             .map(|(a, p)| {
-                let why = a.setup.implausible(p);
+                let mut why = a.setup.implausible(p);
+                why.extend(a.setup.pinned(p));
                 let summary = if why.is_empty() {
                     a.setup.describe(p, &self.data, &self.constants)?
                 } else {

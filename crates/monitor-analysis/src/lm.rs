@@ -235,21 +235,7 @@ pub fn normal_equations<P: LeastSquares>(
     b: &Bounds,
     free: &[usize],
 ) -> (DMatrix<f64>, DVector<f64>) {
-    let cols: Vec<Vec<f64>> = free
-        .par_iter()
-        .map(|&i| {
-            let h = 1e-4 * b.scale[i].max(1e-3 * x[i].abs());
-            let mut xp = x.to_vec();
-            let dir = if xp[i] + h > b.hi[i] { -1.0 } else { 1.0 };
-            xp[i] += dir * h;
-            let rp = if prob.keeps_cache(i) {
-                prob.residuals(&xp, cache)
-            } else {
-                prob.residuals(&xp, &prob.cache(&xp))
-            };
-            rp.iter().zip(r).map(|(a, b)| (a - b) / (dir * h)).collect()
-        })
-        .collect();
+    let cols = jacobian_columns(prob, x, r, cache, b, free);
     let m = free.len();
     let mut jtj = DMatrix::<f64>::zeros(m, m);
     let mut jtr = DVector::<f64>::zeros(m);
@@ -262,6 +248,32 @@ pub fn normal_equations<P: LeastSquares>(
         jtr[a] = cols[a].iter().zip(r).map(|(u, v)| u * v).sum();
     }
     (jtj, jtr)
+}
+
+/// The Jacobian at `x` (residuals `r`, `cache` its cache) by forward differences, one
+/// column per parameter of `free` (each as long as `r`), in parallel.
+pub fn jacobian_columns<P: LeastSquares>(
+    prob: &P,
+    x: &[f64],
+    r: &[f64],
+    cache: &P::Cache,
+    b: &Bounds,
+    free: &[usize],
+) -> Vec<Vec<f64>> {
+    free.par_iter()
+        .map(|&i| {
+            let h = 1e-4 * b.scale[i].max(1e-3 * x[i].abs());
+            let mut xp = x.to_vec();
+            let dir = if xp[i] + h > b.hi[i] { -1.0 } else { 1.0 };
+            xp[i] += dir * h;
+            let rp = if prob.keeps_cache(i) {
+                prob.residuals(&xp, cache)
+            } else {
+                prob.residuals(&xp, &prob.cache(&xp))
+            };
+            rp.iter().zip(r).map(|(a, b)| (a - b) / (dir * h)).collect()
+        })
+        .collect()
 }
 
 #[cfg(test)]

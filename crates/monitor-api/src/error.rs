@@ -135,6 +135,19 @@ pub enum ErrorKind {
 }
 
 impl ApiError {
+    /// Whether the error is a file that does not exist (a log's or a parameter file's):
+    /// Python raises it as a `FileNotFoundError` too.
+    pub fn is_not_found(&self) -> bool {
+        let io = match self {
+            ApiError::Log(LogError::Io { source, .. })
+            | ApiError::Replay(ReplayError::Log(LogError::Io { source, .. }))
+            | ApiError::Analysis(AnalysisError::Log(LogError::Io { source, .. }))
+            | ApiError::Params(ParamError::Io { source, .. }) => Some(source),
+            _ => None,
+        };
+        io.is_some_and(|e| e.kind() == std::io::ErrorKind::NotFound)
+    }
+
     /// Which kind of error this is.
     pub fn kind(&self) -> ErrorKind {
         match self {

@@ -280,6 +280,13 @@ pub struct FleetRow {
     pub turns_high: Option<f64>,
     /// Where the level comes from: `physics` (the model, no labels) or `calibration`.
     pub turns_basis: Option<String>,
+    /// What the residuals were judged against (`commissioning`, `parameter_file`), where
+    /// they were judged.
+    pub against: Option<String>,
+    /// What a healthy verdict could not see on this log (the residuals' reach: without a
+    /// commissioning window, a fault present from the start within the file's own
+    /// uncertainty unless the machine fitted to the log's start is the file's), else null.
+    pub not_seen: Option<String>,
     /// Why the log gave no verdict (a bad file, no motor, a bad option), else null.
     pub error: Option<String>,
 }
@@ -304,6 +311,8 @@ impl FleetRow {
             turns_low: None,
             turns_high: None,
             turns_basis: None,
+            against: None,
+            not_seen: None,
             error: Some(error),
         }
     }
@@ -358,6 +367,15 @@ impl FleetRow {
                 }
                 .to_string()
             }),
+            against: r
+                .findings
+                .iter()
+                .find(|f| {
+                    f.source() == monitor_core::verdict::FindingSource::Residuals
+                        && !f.judged_nothing()
+                })
+                .map(|f| f.finding.against.name().to_string()),
+            not_seen: crate::words::diagnose::machine_fit::not_seen(r),
             error: None,
         }
     }
@@ -496,7 +514,7 @@ fn one_line_error(e: &ApiError) -> String {
 }
 
 /// The columns of the fleet table, in order (the CSV's header).
-pub const COLUMNS: [&str; 17] = [
+pub const COLUMNS: [&str; 19] = [
     "motor",
     "file",
     "rows",
@@ -513,6 +531,8 @@ pub const COLUMNS: [&str; 17] = [
     "turns_low",
     "turns_high",
     "turns_basis",
+    "against",
+    "not_seen",
     "error",
 ];
 

@@ -14,8 +14,8 @@ use monitor_io::log::mapping::ColumnMapping;
 use monitor_io::log::OpenOptions;
 use monitor_io::params::{ParamError, ParamFile};
 use monitor_replay::{
-    diagnose_log, HealthyReference, OptionError, OptionField, ReplayError, ReplayOptions,
-    UnbalanceBaseline,
+    diagnose_log, diagnose_log_fitted, HealthyReference, OptionError, OptionField, ReplayError,
+    ReplayOptions, UnbalanceBaseline,
 };
 use monitor_words::Spelling;
 use std::path::{Path, PathBuf};
@@ -29,6 +29,7 @@ pub mod files;
 pub mod fleet;
 pub mod laws;
 mod log_source;
+mod machine_fit;
 mod outputs;
 /// The replay of a log for a front end (from `monitor-replay`).
 pub mod replay;
@@ -40,6 +41,7 @@ pub use explain_doc::{
     beside_verdict, explain, ladder, mcsa_beside, verdict_for_explain, ExplainDocument,
 };
 pub use log_source::LogSource;
+pub use machine_fit::FIT_WINDOW_S;
 /// The one door: every sentence a crew reads, spelled from the engines' typed values (from
 /// `monitor-words`).
 pub use monitor_words as words;
@@ -309,7 +311,15 @@ pub fn diagnose(
     let log = &log.into();
     let plan = plan_diagnose(params, log, req)?;
     let file = log.open(&plan.open)?;
-    diagnose_log(&plan.params, &file, plan.options, progress).map_err(|e| match e {
+    // Against the file's nominal values (nothing commissioned), the machine fitted to the
+    // log's start tells a fault present from the first sample from the file's error.
+    let fit = plan
+        .options
+        .commission
+        .is_none()
+        .then(|| machine_fit::fit(&plan.params, &file))
+        .flatten();
+    diagnose_log_fitted(&plan.params, &file, plan.options, fit, progress).map_err(|e| match e {
         // Log errors name the file already; the monitor's configuration does not.
         e @ ReplayError::Config { .. } => ApiError::Config {
             log: log.shown(),

@@ -84,10 +84,33 @@ pub fn diagnose_log(
     opts: ReplayOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Diagnosed, ReplayError> {
+    diagnose_log_fitted(params, file, opts, None, progress)
+}
+
+/// [`diagnose_log`] with the full-order machine fitted to the log against the parameter
+/// file (`fit`, where the caller ran one: `monitor_api`'s, from `identify`), which the
+/// parameter fit's finding reads where nothing was commissioned
+/// ([`crate::MachineFit::finding`]).
+///
+/// # Errors
+/// As [`diagnose_file`].
+pub fn diagnose_log_fitted(
+    params: &ParamFile,
+    file: &LogFile,
+    opts: ReplayOptions,
+    fit: Option<crate::MachineFit>,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Diagnosed, ReplayError> {
     let mut bar = Forward::new(progress);
-    let d = replay_through_quality(params, file.channels(), file.shown(), opts, |stage| {
-        read_counted(file, stage, &mut bar)
-    });
+    let d = replay_observed(
+        params,
+        file.channels(),
+        file.shown(),
+        opts,
+        None,
+        fit,
+        |stage| read_counted(file, stage, &mut bar),
+    );
     if d.is_ok() {
         bar.to(1.0);
     }
@@ -128,6 +151,7 @@ pub fn diagnose_file_observed(
         file.shown(),
         opts,
         Some(observer),
+        None,
         |stage| read_counted(&file, stage, &mut bar),
     );
     if d.is_ok() {
@@ -144,7 +168,7 @@ fn replay_through_quality(
     opts: ReplayOptions,
     feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
 ) -> Result<Diagnosed, ReplayError> {
-    replay_observed(params, channels, shown, opts, None, feed)
+    replay_observed(params, channels, shown, opts, None, None, feed)
 }
 
 /// [`replay_through_quality`] with an optional observer of every output. Without one,
@@ -156,6 +180,7 @@ fn replay_observed<'a>(
     shown: &str,
     opts: ReplayOptions,
     observer: Option<&'a mut dyn ReplayObserver>,
+    fit: Option<crate::MachineFit>,
     feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
 ) -> Result<Diagnosed, ReplayError> {
     match observer {
@@ -166,7 +191,7 @@ fn replay_observed<'a>(
                     let (read, quality) = through_quality(&mut sink, params, shown, feed);
                     (read, quality, sink.into_parts().1)
                 });
-            conclude(replay?, &handled, read, quality, shown, opts)
+            conclude(replay?, &handled, (read, quality), shown, opts, fit)
         }
         Some(o) => {
             let direct = Direct::new(params, channels, opts, Some(o));
@@ -176,7 +201,14 @@ fn replay_observed<'a>(
             if let Some(e) = direct.error.take() {
                 return Err(e);
             }
-            conclude(direct.replay.take(), &handled, read, quality, shown, opts)
+            conclude(
+                direct.replay.take(),
+                &handled,
+                (read, quality),
+                shown,
+                opts,
+                fit,
+            )
         }
     }
 }
@@ -199,10 +231,10 @@ fn through_quality<S: CleanSink>(
 fn conclude(
     replay: Option<Replay>,
     handled: &Handled,
-    read: Result<(), LogError>,
-    quality: Result<DataQuality, LogError>,
+    (read, quality): (Result<(), LogError>, Result<DataQuality, LogError>),
     shown: &str,
     opts: ReplayOptions,
+    fit: Option<crate::MachineFit>,
 ) -> Result<Diagnosed, ReplayError> {
     read?;
     let mut quality = quality?;
@@ -231,6 +263,9 @@ fn conclude(
         .monitor()
         .map_or_else(SensorFlags::default, |m| m.output().sensor_fault);
     let mut report = replay.end();
+    if let Some(f) = fit.as_ref().and_then(crate::MachineFit::finding) {
+        report.put_machine_fit(f);
+    }
     describe_actions(&mut quality, can_residuals, handled);
     let dq = DataQualityStage::new(quality).finish(sensors);
     // Data the stage does not trust carry no finding (the sensors' impossible readings at

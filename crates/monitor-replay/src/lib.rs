@@ -56,7 +56,10 @@ pub use verdict::measured::{watched_phase, winding_against, WINDING_WATCH_PROBAB
 pub use verdict::{MIN_FAULT_CHANGE, MIN_JUDGED_S};
 pub use windows::SENSOR_PHASE_MIN_RATIO;
 
-pub use diagnose::{diagnose_file, diagnose_file_observed, diagnose_log, diagnose_rows, Diagnosed};
+pub use diagnose::{
+    diagnose_file, diagnose_file_observed, diagnose_log, diagnose_log_fitted, diagnose_rows,
+    Diagnosed,
+};
 pub use events::{IsolationEvent, LOAD_MOVE_FRACTION, MAX_EVENTS};
 pub use isolation::said::{
     CoreSaid, IsolationSaid, JointEvidence, Nearest, NotIsolatedWhy, SensorKind, Stale, MOVED_FAR,
@@ -96,6 +99,7 @@ pub use fields::{
     field_given, OptionError, OptionField, OptionSpec, OptionValue, Takes, DIAGNOSE_OPTIONS,
 };
 pub use timeline::{MonitorState, MovedWhy, Panel, TimelinePoint};
+pub use verdict::machine_fit::{FitParameter, FittedChange, MachineFit};
 pub use verdict::{Detail, FileMisfit, FindingReport, Rule, SkippedAnalysis, Verdict};
 pub use winding::level::{LabelledRun, LevelBasis, ShortedTurns, TurnCalibration, TurnReach};
 pub use winding::{

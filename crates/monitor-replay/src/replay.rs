@@ -301,6 +301,7 @@ impl Replay {
     /// the report with its findings, the verdict not decided yet (`diagnose` adds the
     /// data-quality stage's finding first).
     pub(crate) fn end(self) -> DiagnoseReport {
+        let bands = self.threshold_bands().map(|b| b.map(|(c, w)| [c, w]));
         let rows = self.clock.finish(());
         let sequences = self.sequences.finish(());
         let lamps = self.lamps.finish(());
@@ -329,13 +330,15 @@ impl Replay {
             signature: &signature,
         });
         let timeline = self.timeline.finish(());
-        DiagnoseReport::undecided(
+        let mut report = DiagnoseReport::undecided(
             rows,
             (lamps, isolation),
             (unbalance, rotor),
             signature,
             timeline,
-        )
+        );
+        report.threshold_bands = bands;
+        report
     }
 }
 

@@ -73,6 +73,11 @@ pub struct DiagnoseReport {
     pub max_abs_residual: [f32; 4],
     /// Timeline (one point per `timeline_step_s`).
     pub timeline: Vec<TimelinePoint>,
+    /// The threshold band of each normalised residual r1..r4 in force at the log's end,
+    /// `[centre, half-width]` (the learned mean and `k_sigma` spreads once commissioned
+    /// (in force from the commissioning window's end), else 0 and the fixed threshold): a
+    /// residual outside its band lights its lamp. Null for a log without the residuals.
+    pub threshold_bands: Option<[[f32; 2]; 4]>,
 }
 
 /// The final lamps' matching against the signature matrix: the faults with a probability,
@@ -143,6 +148,7 @@ impl DiagnoseReport {
             rows,
             max_abs_residual: lamps.max_abs,
             timeline,
+            threshold_bands: None,
         }
     }
 
@@ -154,6 +160,26 @@ impl DiagnoseReport {
         self.verdict = c.verdict;
         self.verdict_rule = c.rule;
         self.verdict_finding = c.finding;
+    }
+
+    /// The parameter fit's finding from the machine fitted to the log (`f`,
+    /// [`crate::MachineFit::finding`]), where the residuals were judged against the file:
+    /// a fault it names replaces the residuals' parameter-fit finding; the machine on the
+    /// file replaces only a clear one (a misfit the residuals saw stands).
+    pub(crate) fn put_machine_fit(&mut self, f: FindingReport) {
+        use monitor_core::verdict::{Against, FindingSource, State};
+        let Some(old) = self
+            .findings
+            .iter()
+            .find(|g| g.source() == FindingSource::ParameterFit)
+        else {
+            return;
+        };
+        let replaces = old.finding.against == Against::ParameterFile
+            && (matches!(f.finding.state, State::Named(_)) || old.finding.state == State::Clear);
+        if replaces {
+            put(&mut self.findings, f);
+        }
     }
 
     /// Data that cannot carry a verdict (`why`): every fault-judging finding that judged

@@ -362,3 +362,50 @@ fn a_slope_that_may_be_flat_projects_no_days_to_fault() {
     );
     assert!(!i2.alarm);
 }
+
+/// Issue 86: fourteen daily logs of a motor whose short grows to the FAULT level (from day
+/// 9 on |I2w|/|I1| at or beyond its level, 0.05), every log's verdict `healthy` (judged
+/// alone against the file). The trend says "at the FAULT level on the last 6 logs in a
+/// row"; the reference, the motor's first healthy logs, must not take in those at the
+/// FAULT level, so that the plot's band (the reference's centre and scatter) says what
+/// the text says: the last log many reference scatters out.
+#[test]
+fn logs_at_the_fault_level_are_no_reference_whatever_their_verdict() {
+    let rows: Vec<StoredRow> = (1..=14)
+        .map(|d| {
+            let v = if d <= 8 {
+                0.01
+            } else {
+                0.052 + 0.004 * (d - 9) as f64
+            };
+            row(
+                "fan",
+                d,
+                "healthy",
+                &[
+                    ("i2_over_i1", v + noise(d)),
+                    ("i2_least_change", 0.05),
+                    ("i1_peak_a", 10.0),
+                ],
+            )
+        })
+        .collect();
+    let m = motor(&rows, 15, &TrendOptions::default());
+    let t = ind(&m, "i2_over_i1");
+    assert!(t.alarm, "{:?}", t.reason);
+    let refs: Vec<f64> = t
+        .series
+        .iter()
+        .filter(|p| p.in_reference)
+        .map(|p| p.value)
+        .collect();
+    assert_eq!(refs.len(), 8, "{refs:?}");
+    assert!(refs.iter().all(|v| *v < 0.02), "{refs:?}");
+    let centre = t.reference_centre.expect("a centre");
+    assert!((centre - 0.01).abs() < 0.002, "{centre}");
+    assert!(
+        t.from_reference_scatters.is_some_and(|s| s > 10.0),
+        "{:?}",
+        t.from_reference_scatters
+    );
+}

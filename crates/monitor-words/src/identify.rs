@@ -2,7 +2,7 @@
 //! identification is not written.
 
 use crate::Spelling;
-use monitor_analysis::identify::{IdentifyError, IdentifyRefusal};
+use monitor_analysis::identify::{IdentifyError, IdentifyRefusal, SupplyFromLog};
 use monitor_replay::OptionField;
 
 /// Why the identification could not run on a log: the error's own message, except where it
@@ -49,4 +49,12 @@ pub fn refusal(r: &IdentifyRefusal, sp: &dyn Spelling) -> String {
             "an identified value is not one of a real machine ({key}: {message}): a unit or a mapping is likely wrong"
         ),
     }
+}
+
+/// The log's supply where it differs from the start file's: what the identified file takes.
+pub fn supply_from_log(l: &SupplyFromLog) -> String {
+    format!(
+        "the log's supply is {:.0} V {:.1} Hz, the start file's {:.0} V {:.1} Hz: the identified file takes the log's (check f_hz and v_ll_rms)",
+        l.log_v_ll_rms, l.log_f_hz, l.file_v_ll_rms, l.file_f_hz
+    )
 }

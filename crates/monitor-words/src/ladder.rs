@@ -156,8 +156,8 @@ pub fn not_physical(w: &WhyNotPhysical) -> String {
             low,
             high,
         } => format!(
-            "{effect}: {parameter} = {} {unit} is at the bound of its fit ({}..{}), not a value the log shows",
-            sig(*value),
+            "{effect}: {parameter} = {} is at the bound of its fit ({}..{}), not a value the log shows",
+            monitor_analysis::effects::with_unit(&sig(*value), unit),
             sig(*low),
             sig(*high)
         ),

@@ -282,18 +282,20 @@ pub fn normalisation(n: &Normalisation) -> String {
 }
 
 /// Which logs are the motor's reference ("the motor's first 14 days of logs whose verdict
-/// is not FAULT").
+/// is healthy or watching").
 pub fn reference_how(r: &TrendReference) -> String {
     let how = match &r.basis {
         ReferenceBasis::Marked { until_day } => format!("the logs up to {until_day} (marked)"),
         ReferenceBasis::FirstHealthyDays { days } => {
-            format!("the motor's first {days} days of logs whose verdict is not FAULT")
+            format!("the motor's first {days} days of logs whose verdict is healthy or watching")
         }
         ReferenceBasis::FirstHealthyLogs { logs } => {
-            format!("the motor's first {logs} logs whose verdict is not FAULT")
+            format!("the motor's first {logs} logs whose verdict is healthy or watching")
         }
         ReferenceBasis::FirstDaysAllFault { days } => {
-            format!("the motor's first {days} days of logs (every log's verdict is FAULT)")
+            format!(
+                "the motor's first {days} days of logs (no log's verdict is healthy or watching)"
+            )
         }
     };
     match &r.mark_without_logs {

@@ -136,7 +136,7 @@ fn too_few_logs_say_their_stored_values_and_the_normalisation_its_reason() {
     // Every verdict FAULT: the reference is the first days' logs, and says so.
     assert_eq!(
         reference_how(&m.reference),
-        "the motor's first 14 days of logs (every log's verdict is FAULT)"
+        "the motor's first 14 days of logs (no log's verdict is healthy or watching)"
     );
     // Only what the logs measured: no |I2w|/|I1|, no sideband, no Rs beyond Rr.
     let names: Vec<&str> = m.indicators.iter().map(|i| i.indicator.as_str()).collect();
@@ -161,7 +161,7 @@ fn the_json_keeps_its_keys_with_the_typed_reasons_beside_them() {
     let r = &doc[0]["reference"];
     assert_eq!(
         r["how"],
-        "the motor's first 6 logs whose verdict is not FAULT"
+        "the motor's first 4 logs whose verdict is healthy or watching"
     );
     assert_eq!(r["basis"]["kind"], "first_healthy_logs");
     assert_eq!(r["logs"], 4);

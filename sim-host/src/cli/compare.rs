@@ -284,7 +284,7 @@ pub fn run_compare(args: &CompareArgs) -> anyhow::Result<()> {
         let doc = monitor_api::words::compare::document(&out.report, &super::words::CliWords);
         render::json::print(&mut crate::cli::out::stdout(), &doc)
     } else {
-        render::text::compare(&mut crate::cli::out::stdout(), &c.log, &out.report)
+        render::text::compare(&mut crate::cli::out::text(), &c.log, &out.report)
     }
 }
 
@@ -310,7 +310,7 @@ fn explain_here(
     let compared = if args.compare {
         let out = a.compare(&opts)?;
         if !c.json {
-            render::text::compare(&mut crate::cli::out::stdout(), &c.log, &out.report)?;
+            render::text::compare(&mut crate::cli::out::text(), &c.log, &out.report)?;
         }
         Some(out.report)
     } else {
@@ -400,7 +400,7 @@ fn print_explain(
             },
         ),
         (Some(explain), None) => render::json::print(&mut crate::cli::out::stdout(), &explain),
-        (None, _) => render::text::explain(&mut crate::cli::out::stdout(), &c.log, doc),
+        (None, _) => render::text::explain(&mut crate::cli::out::text(), &c.log, doc),
     }
 }
 
@@ -431,6 +431,6 @@ fn run_ladder(c: &Common) -> anyhow::Result<()> {
         let doc = monitor_api::words::ladder::document(&report, &super::words::CliWords);
         render::json::print(&mut crate::cli::out::stdout(), &doc)
     } else {
-        render::text::ladder(&mut crate::cli::out::stdout(), &c.log, &report)
+        render::text::ladder(&mut crate::cli::out::text(), &c.log, &report)
     }
 }

@@ -158,6 +158,6 @@ pub fn run(args: &ConvertArgs) -> anyhow::Result<()> {
     if args.json {
         render::json::print(&mut crate::cli::out::stdout(), &done)
     } else {
-        render::text::convert(&mut crate::cli::out::stdout(), &done)
+        render::text::convert(&mut crate::cli::out::text(), &done)
     }
 }

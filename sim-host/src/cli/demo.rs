@@ -69,6 +69,6 @@ pub fn run(args: &DemoArgs) -> anyhow::Result<()> {
     if args.json {
         render::json::print(&mut crate::cli::out::stdout(), &render::json::demo(&run))
     } else {
-        render::text::demo(&mut crate::cli::out::stdout(), &run)
+        render::text::demo(&mut crate::cli::out::text(), &run)
     }
 }

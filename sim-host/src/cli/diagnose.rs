@@ -204,7 +204,7 @@ pub fn run(args: &DiagnoseArgs) -> anyhow::Result<()> {
             &monitor_api::words::diagnose::document(&d.report, &super::words::CliWords),
         )
     } else {
-        render::text::diagnose(&mut crate::cli::out::stdout(), &args.log, &d)
+        render::text::diagnose(&mut crate::cli::out::text(), &args.log, &d)
     }
 }
 

@@ -124,6 +124,7 @@ pub fn run(args: &IdentifyArgs) -> anyhow::Result<()> {
         });
         writeln!(stdout, "{}", serde_json::to_string_pretty(&doc)?)?;
     } else {
+        let mut stdout = super::out::text();
         write!(stdout, "{}", table(id))?;
         match &args.out {
             Some(out) => writeln!(stdout, "wrote {}", out.display())?,
@@ -198,6 +199,12 @@ fn table(id: &Identification) -> String {
     }
     if let Some(g) = &id.inverse_gamma {
         s.push_str(&format!("{}\n", identify::inverse_gamma_line("", g)));
+    }
+    if let Some(l) = &id.supply_from_log {
+        s.push_str(&format!(
+            "{}\n",
+            monitor_api::words::identify::supply_from_log(l)
+        ));
     }
     s.push_str(&format!(
         "(the full-order model over {:.3}..{:.3} s, a start or steps included; compare and explain judge the paper's steady-state model: leave a start out there with --from, as compare's advice says)\n",

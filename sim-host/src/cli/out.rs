@@ -1,5 +1,5 @@
 //! What every command writes through: standard output whose write errors are marked
-//! ([`stdout`]), a file written atomically when asked ([`write_out`]), and SIGINT/SIGTERM as
+//! ([`stdout`]; text a crew reads wrapped at [`LINE_WIDTH`]: [`text`]), a file written atomically when asked ([`write_out`]), and SIGINT/SIGTERM as
 //! a flag a long loop checks ([`Interruption`]) with the error it ends in ([`Interrupted`]).
 
 /// Writes `bytes` to `out` atomically when an output was asked for (`--out`); nothing
@@ -19,8 +19,110 @@ pub fn write_out(out: Option<&std::path::Path>, bytes: &[u8]) -> anyhow::Result<
 /// Standard output for the renderers: locked, and every write error marked as a
 /// [`StdoutError`] (kept as the `io::Error`'s inner error, its kind unchanged), so that
 /// `main` can tell a closed pipe (quiet exit) or a full disk on stdout from other errors.
+/// What is written goes out as it is (JSON, CSV); text a crew reads goes through [`text`].
 pub fn stdout() -> Stdout {
     Stdout(std::io::stdout().lock())
+}
+
+/// [`stdout`] for text a crew reads: every line longer than [`LINE_WIDTH`] characters is
+/// wrapped ([`wrap`]), a list one item a line.
+pub fn text() -> Wrapped<Stdout> {
+    Wrapped {
+        out: stdout(),
+        line: Vec::new(),
+    }
+}
+
+/// The longest line the text outputs print.
+pub const LINE_WIDTH: usize = 160;
+
+/// `line` as the lines a reader gets, none longer than [`LINE_WIDTH`] characters (a line
+/// that fits is kept whole): a list (items joined by `"; "`) one item a line, any part still
+/// too long broken at its last space that fits, each following line indented by the
+/// line's own indent and four spaces more.
+pub fn wrap(line: &str) -> Vec<String> {
+    if line.chars().count() <= LINE_WIDTH {
+        return vec![line.to_string()];
+    }
+    let lead = line.len() - line.trim_start().len();
+    let more = format!("{}    ", &line[..lead]);
+    let mut out: Vec<String> = Vec::new();
+    let items: Vec<&str> = line.split_inclusive("; ").collect();
+    for (k, item) in items.iter().enumerate() {
+        let item = if k + 1 < items.len() {
+            item.trim_end()
+        } else {
+            item
+        };
+        let mut rest = if k == 0 { item } else { item.trim_start() };
+        let mut prefix = if k == 0 { "" } else { more.as_str() };
+        loop {
+            let room = LINE_WIDTH.saturating_sub(prefix.chars().count()).max(20);
+            if rest.chars().count() <= room {
+                out.push(format!("{prefix}{rest}"));
+                break;
+            }
+            // The byte index of the `room`-th character, and the last space before it.
+            let end = rest.char_indices().nth(room).map_or(rest.len(), |(i, _)| i);
+            let cut = rest[..end]
+                .rfind(' ')
+                .filter(|&i| i > end / 4)
+                .unwrap_or(end);
+            out.push(format!("{prefix}{}", rest[..cut].trim_end()));
+            rest = rest[cut..].trim_start();
+            prefix = more.as_str();
+        }
+    }
+    out
+}
+
+/// A writer whose lines are [`wrap`]ped: it holds the line being written until its end.
+pub struct Wrapped<W: std::io::Write> {
+    out: W,
+    line: Vec<u8>,
+}
+
+impl<W: std::io::Write> Wrapped<W> {
+    /// Writes the line held, wrapped, and `end` after it.
+    fn emit(&mut self, end: &[u8]) -> std::io::Result<()> {
+        let line = String::from_utf8_lossy(&self.line).into_owned();
+        self.line.clear();
+        let lines = wrap(&line);
+        let n = lines.len();
+        for (k, l) in lines.into_iter().enumerate() {
+            self.out.write_all(l.as_bytes())?;
+            if k + 1 < n {
+                self.out.write_all(b"\n")?;
+            }
+        }
+        self.out.write_all(end)
+    }
+}
+
+impl<W: std::io::Write> std::io::Write for Wrapped<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let mut rest = buf;
+        while let Some(k) = rest.iter().position(|b| *b == b'\n') {
+            self.line.extend_from_slice(&rest[..k]);
+            self.emit(b"\n")?;
+            rest = &rest[k + 1..];
+        }
+        self.line.extend_from_slice(rest);
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        if !self.line.is_empty() {
+            self.emit(b"")?;
+        }
+        self.out.flush()
+    }
+}
+
+impl<W: std::io::Write> Drop for Wrapped<W> {
+    fn drop(&mut self) {
+        let _ = std::io::Write::flush(self);
+    }
 }
 
 /// Locked standard output whose write errors are [`StdoutError`]s ([`stdout`]).
@@ -130,5 +232,35 @@ impl Interruption {
             },
             what: what.to_string(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_long_line_wraps_a_list_one_item_a_line_and_a_short_one_stays() {
+        assert_eq!(wrap("verdict: healthy"), ["verdict: healthy"]);
+        let items: Vec<String> = (0..8)
+            .map(|k| format!("item {k} {}", "x".repeat(25)))
+            .collect();
+        let line = format!("  verdict: {}", items.join("; "));
+        let lines = wrap(&line);
+        assert!(
+            lines.iter().all(|l| l.chars().count() <= LINE_WIDTH),
+            "{lines:#?}"
+        );
+        assert_eq!(lines.len(), 8, "{lines:#?}");
+        assert!(lines[1].starts_with("      item 1"), "{lines:#?}");
+        let words = format!("model's error: {}", "word ".repeat(80));
+        let lines = wrap(&words);
+        assert!(lines.len() > 2 && lines.iter().all(|l| l.chars().count() <= LINE_WIDTH));
+        // Nothing lost but the spaces the breaks took.
+        let back: String = lines.iter().map(|l| l.trim()).collect::<Vec<_>>().join(" ");
+        assert_eq!(
+            back.split_whitespace().count(),
+            words.split_whitespace().count()
+        );
     }
 }

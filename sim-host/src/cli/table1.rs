@@ -53,6 +53,6 @@ pub fn run(args: &Table1Args) -> anyhow::Result<()> {
     if args.json {
         render::json::print(&mut crate::cli::out::stdout(), &table)
     } else {
-        render::text::table1(&mut crate::cli::out::stdout(), &table)
+        render::text::table1(&mut crate::cli::out::text(), &table)
     }
 }

@@ -29,7 +29,7 @@ side of zero AND the line moves the indicator by more than --k scatters over the
 level (the level a single log's verdict names the fault at), the days until the line reaches \
 it, where Sen's interval excludes a flat line. Once raised, the alarm holds until the \
 indicator is back within --k scatters of the motor's reference (its first --window-days of logs \
-whose verdict is not FAULT, or its logs up to --reference-until) on two logs in a row.\n\nWithout --motor: the fleet's motors, alarmed first, then the fastest-moving (the \
+whose verdict is healthy or watching, or its logs up to --reference-until) on two logs in a row.\n\nWithout --motor: the fleet's motors, alarmed first, then the fastest-moving (the \
 indicator that moves most, in scatters over the window).\n\nExamples:\n  sim-host fleet \
 motors.toml logs/*.csv --store history.db\n  sim-host trend --store history.db\n  sim-host \
 trend --store history.db --motor pump_7 --plot pump_7.svg\n  sim-host trend --store history.db \
@@ -54,7 +54,7 @@ pub struct TrendArgs {
     pub k: f64,
     /// The baseline: each motor's logs up to the end of this UTC day (YYYY-MM-DD) are its
     /// reference (the bands, the scatters from the reference, the alarm's clearing).
-    /// Default: each motor's first --window-days of logs whose verdict is not FAULT.
+    /// Default: each motor's first --window-days of logs whose verdict is healthy or watching.
     #[arg(long, value_name = "DATE")]
     pub reference_until: Option<String>,
     /// Draw the indicators over time (with the OK / WATCH / FAULT bands) into FILE.svg or
@@ -122,7 +122,7 @@ pub fn run(args: &TrendArgs) -> anyhow::Result<()> {
             },
         );
     }
-    let mut out = super::out::stdout();
+    let mut out = super::out::text();
     print_table(&mut out, &motors, args.motor.is_some())?;
     Ok(())
 }

@@ -133,9 +133,53 @@ const ABOUT: About = About {
     parameters: &PARAMS,
 };
 
+/// The least share of its unsaturated value a running motor's magnetising inductance keeps
+/// over a log: the rated point lies at the knee of the magnetising curve, where Lm is
+/// about 70-95 % of its unsaturated value, and 10 % over the rated voltage takes a few
+/// tenths more (Fitzgerald and Kingsley, *Electric Machinery*, the magnetisation curve); a
+/// fit that takes it below this is no saturation of a running machine.
+pub const LM_SHARE_MIN: f64 = 0.4;
+
+/// The lowest and highest share of its unsaturated value the law `p` gives Lm over the log
+/// `d`: the factor falls monotonically with |i_f|, so its extremes are at the extremes of
+/// |i_f|.
+fn lm_span(p: &SaturationValues, d: &Prepared, n: &MachineConstants) -> (f64, f64) {
+    let (psi_sat, nexp) = (p.psi_sat_wb, p.exponent);
+    let (mut imin, mut imax) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &i in &d.i_f {
+        imin = imin.min(i.abs());
+        imax = imax.max(i.abs());
+    }
+    let k0 = n.lm0_over_file(psi_sat, nexp);
+    if imax >= imin {
+        (
+            sat_factor(k0 * n.lm_h, imax, psi_sat, nexp),
+            sat_factor(k0 * n.lm_h, imin, psi_sat, nexp),
+        )
+    } else {
+        (f64::INFINITY, 0.0)
+    }
+}
+
 impl EffectModel for Saturation {
     fn about(&self) -> &About {
         &ABOUT
+    }
+    fn contradicted_by(
+        &self,
+        d: &Prepared,
+        n: &MachineConstants,
+        fitted: &[f64],
+    ) -> Result<Option<String>, EffectValuesError> {
+        let v = SaturationValues::try_from(fitted)?;
+        let (lo, _) = lm_span(&v, d, n);
+        Ok((lo < LM_SHARE_MIN).then(|| {
+            format!(
+                "Lm would fall to {:.0} % of its unsaturated value on this log: a running motor's stays above about {:.0} % (its rated point lies at the knee)",
+                100.0 * lo,
+                100.0 * LM_SHARE_MIN
+            )
+        }))
     }
     fn setup(&self, d: &Prepared, _n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let psi = rated_flux_wb(d);
@@ -186,20 +230,12 @@ impl Contribution for SaturationOnLog {
     }
     fn describe(&self, p: &SaturationValues, d: &Prepared, n: &MachineConstants) -> String {
         let (psi_sat, nexp) = (p.psi_sat_wb, p.exponent);
-        // The factor falls monotonically with |i_f|: its extremes are at the extremes of |i_f|.
-        let (mut imin, mut imax) = (f64::INFINITY, f64::NEG_INFINITY);
-        for &i in &d.i_f {
-            imin = imin.min(i.abs());
-            imax = imax.max(i.abs());
-        }
         let k0 = n.lm0_over_file(psi_sat, nexp);
-        let (lo, hi) = if imax >= imin {
-            (
-                sat_factor(k0 * n.lm_h, imax, psi_sat, nexp),
-                sat_factor(k0 * n.lm_h, imin, psi_sat, nexp),
-            )
+        let (lo, hi) = lm_span(p, d, n);
+        let span = if hi - lo < 0.005 {
+            format!("about {:.0} %", 50.0 * (lo + hi))
         } else {
-            (f64::INFINITY, 0.0)
+            format!("{:.0} % to {:.0} %", lo * 100.0, hi * 100.0)
         };
         let file = match n.lm_point {
             monitor_core::LmPoint::Rated => format!(
@@ -209,9 +245,7 @@ impl Contribution for SaturationOnLog {
             monitor_core::LmPoint::Unsaturated => String::new(),
         };
         format!(
-            "magnetising inductance falls with flux: Lm is {:.0} % to {:.0} % of its unsaturated value over this log (saturation flux {:.2} Wb = {:.2} x the rated flux, knee exponent {:.1}{file})",
-            lo * 100.0,
-            hi * 100.0,
+            "magnetising inductance falls with flux: Lm is {span} of its unsaturated value over this log (saturation flux {:.2} Wb = {:.2} x the rated flux, knee exponent {:.1}{file})",
             psi_sat,
             psi_sat / self.rated_flux_wb,
             nexp

@@ -384,6 +384,29 @@ impl FitSetup {
             .collect()
     }
 
+    /// Why the values `p` are no finding where they sit at a bound of their fit: the solver
+    /// pushed them as far as it was let, so the log shows no minimum there (a bound at 0,
+    /// no effect at all, does not count; the ladder's own rule, `explain::ladder`). One
+    /// line per value: `exponent = 14.0 is at the bound of its fit (2.00..14.0), not a
+    /// value the log shows`.
+    pub fn pinned(&self, p: &[f64]) -> Vec<String> {
+        let at = |v: f64, b: f64| b.is_finite() && b != 0.0 && (v - b).abs() <= 1e-3 * b.abs();
+        self.params
+            .iter()
+            .zip(p)
+            .filter(|(q, v)| at(**v, q.lo) || at(**v, q.hi))
+            .map(|(q, v)| {
+                format!(
+                    "{} = {} is at the bound of its fit ({}..{}), not a value the log shows",
+                    q.name,
+                    with_unit(&sig(*v), q.unit()),
+                    sig(q.lo),
+                    with_unit(&sig(q.hi), q.unit())
+                )
+            })
+            .collect()
+    }
+
     /// The effect's contribution to the model for the values `p` ([`Contribution`]).
     ///
     /// # Errors

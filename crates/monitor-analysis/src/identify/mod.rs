@@ -15,9 +15,10 @@
 //!    `T_e` from the identified electrical model ([`mechanics`]).
 //!
 //! Each value's 95 % interval is `exp(x +- 1.96 sigma)` around the log-space estimate,
-//! `sigma^2` the diagonal of `s^2 (J^T J)^-1` at the optimum, `s^2` the residual variance
-//! (Gauss-Newton covariance; it assumes white residuals, so it is a lower bound on the
-//! real uncertainty when the model misses an effect). A value whose interval is wider
+//! `sigma^2` the larger of the diagonal of `s^2 (J^T J)^-1` at the optimum (`s^2` the
+//! residual variance: the Gauss-Newton covariance, white residuals) and the block
+//! sandwich covariance that takes in the model's error ([`uncertainty`]: what the
+//! residual's structure says), scaled to Student's t. A value whose interval is wider
 //! than the value itself, or whose direction the data leave flat (a singular `J^T J`), is
 //! "not identified", with the reason; the written file keeps the start value for it.
 //!
@@ -30,6 +31,7 @@ pub mod model;
 mod output;
 mod refuse;
 mod samples;
+pub mod uncertainty;
 
 use crate::lm::{self, Bounds};
 use model::{CurrentFit, IdentifiedCircuit, N_PARAMS};
@@ -105,6 +107,63 @@ pub struct Identification {
     pub relative_rms_error: f64,
     /// How the solver ended.
     pub solver: lm::Report,
+    /// The log's supply where it differs from the start file's (the written file takes the
+    /// log's, [`SupplyFromLog`]); `None` where the file's holds.
+    pub supply_from_log: Option<SupplyFromLog>,
+}
+
+/// The supply the log was recorded on, where it differs from the start file's by more than
+/// [`SUPPLY_FREQUENCY_OFF`] in frequency or [`SUPPLY_VOLTAGE_OFF`] in voltage: `identify`
+/// reports it and writes the log's into the identified file (a 220 V 60 Hz file given for a
+/// 400 V 50 Hz log kept both without a word). JSON `supply_from_log`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SupplyFromLog {
+    /// The file's line-to-line RMS voltage [V].
+    pub file_v_ll_rms: f64,
+    /// The log's: the median over the log of the voltage vector's magnitude, as a
+    /// line-to-line RMS [V].
+    pub log_v_ll_rms: f64,
+    /// The file's frequency [Hz].
+    pub file_f_hz: f64,
+    /// The log's: the voltage vector's mean turn over the log [Hz].
+    pub log_f_hz: f64,
+}
+
+/// Relative difference of the log's supply frequency from the file's beyond which the log's
+/// is taken (the data-quality stage's `SUPPLY_MISMATCH`).
+pub const SUPPLY_FREQUENCY_OFF: f64 = 0.05;
+/// Relative difference of the log's median voltage from the file's beyond which the log's
+/// is taken: a variac's or a grid's +-10 % stays within it.
+pub const SUPPLY_VOLTAGE_OFF: f64 = 0.15;
+
+/// The log's supply against `start`'s ([`SupplyFromLog`]), where it differs.
+fn supply_from_log(start: &ParamFile, s: &Samples) -> Option<SupplyFromLog> {
+    let mut mags: Vec<f64> = s.v_ab.iter().map(|v| v[0].hypot(v[1])).collect();
+    mags.sort_by(f64::total_cmp);
+    let median = *mags.get(mags.len() / 2)?;
+    // The vector's turn, unwrapped, over the whole log.
+    let angle = |v: &[f64; 2]| v[1].atan2(v[0]);
+    let turned: f64 = s
+        .v_ab
+        .windows(2)
+        .map(|w| {
+            let d = angle(&w[1]) - angle(&w[0]);
+            (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+        })
+        .sum();
+    let span = s.dt_s * (s.v_ab.len().saturating_sub(1)) as f64;
+    let f = turned.abs() / std::f64::consts::TAU / span.max(f64::MIN_POSITIVE);
+    let v_ll = median * 1.5f64.sqrt();
+    let (file_v, file_f) = (start.supply.v_ll_rms, start.supply.f_hz);
+    let off = |x: f64, y: f64| (x / y - 1.0).abs();
+    (median > 0.0
+        && (off(f, file_f) > SUPPLY_FREQUENCY_OFF || off(v_ll, file_v) > SUPPLY_VOLTAGE_OFF))
+        .then_some(SupplyFromLog {
+            file_v_ll_rms: file_v,
+            log_v_ll_rms: v_ll,
+            file_f_hz: file_f,
+            log_f_hz: f,
+        })
 }
 
 /// The inverse-Gamma equivalent circuit (Slemon, "Modelling of induction machines for
@@ -242,7 +301,12 @@ pub fn identify(
         estimates[5] = estimate_or(5, c0.b_total_nms, mech.b_total);
     }
     progress(1.0);
-    let params = output::written_params(start, &estimates, c0.stator_leakage_share);
+    let mut params = output::written_params(start, &estimates, c0.stator_leakage_share);
+    let supply = supply_from_log(start, s);
+    if let Some(l) = supply {
+        params.supply.v_ll_rms = l.log_v_ll_rms;
+        params.supply.f_hz = l.log_f_hz;
+    }
     let inverse_gamma = InverseGamma::of_estimates(&estimates, c0.stator_leakage_share);
     estimates.extend(output::leakage_split(&estimates, start));
     Ok(Identification {
@@ -256,6 +320,7 @@ pub fn identify(
         relative_rms_error_start: rel_rms(cost0, n_res),
         relative_rms_error: rel_rms(solver.cost, n_res),
         solver,
+        supply_from_log: supply,
     })
 }
 
@@ -306,9 +371,10 @@ fn estimates_of(prob: &CurrentFit<'_>, x: &[f64], free: &[usize], sigma: &[f64])
         .collect()
 }
 
-/// The log-space standard deviations of the free parameters at `x`: the square roots of
-/// the diagonal of `s^2 (J^T J)^-1`, `s^2 = 2 cost / (n - m)`; infinite where `J^T J` is
-/// singular (a flat direction).
+/// The log-space standard deviations of the free parameters at `x`: the larger of the
+/// Gauss-Newton figure (the diagonal of `s^2 (J^T J)^-1`, `s^2 = 2 cost / (n - m)`) and the
+/// block sandwich's, which takes in the model's error ([`uncertainty`]); infinite where
+/// `J^T J` is singular (a flat direction).
 fn log_sigmas(
     prob: &CurrentFit<'_>,
     x: &[f64],
@@ -318,10 +384,10 @@ fn log_sigmas(
     n: usize,
 ) -> Vec<f64> {
     let r = lm::LeastSquares::residuals(prob, x, &());
-    let (jtj, _) = lm::normal_equations(prob, x, &r, &(), b, free);
+    let cols = lm::jacobian_columns(prob, x, &r, &(), b, free);
     let m = free.len();
     let s2 = 2.0 * cost / (n.saturating_sub(m).max(1)) as f64;
-    covariance_sigmas(&jtj, s2, FLAT_RELATIVE_EIGENVALUE)
+    uncertainty::sigmas_with_model_error(&cols, &r, prob.samples.dt_s, s2, FLAT_RELATIVE_EIGENVALUE)
 }
 
 /// Eigenvalue of `J^T J` (log-space parameters), relative to the largest, below which a

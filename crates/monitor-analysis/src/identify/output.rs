@@ -99,16 +99,21 @@ pub fn to_toml(id: &Identification, start_text: &str, start_name: &str, log_name
     }
     s.push_str(&motor_entries(id));
     s.push_str("[supply]\n");
-    s.push_str(&toml_entry(
-        "v_ll_rms",
-        id.params.supply.v_ll_rms,
-        "from the start file",
-    ));
-    s.push_str(&toml_entry(
-        "f_hz",
-        id.params.supply.f_hz,
-        "from the start file",
-    ));
+    let (v_from, f_from) = match id.supply_from_log {
+        Some(l) => (
+            format!(
+                "the log's (median of its voltage vector; the start file's {} V)",
+                toml_number(l.file_v_ll_rms)
+            ),
+            format!(
+                "the log's (its voltage vector's turn; the start file's {} Hz)",
+                toml_number(l.file_f_hz)
+            ),
+        ),
+        None => ("from the start file".into(), "from the start file".into()),
+    };
+    s.push_str(&toml_entry("v_ll_rms", id.params.supply.v_ll_rms, &v_from));
+    s.push_str(&toml_entry("f_hz", id.params.supply.f_hz, &f_from));
     let columns = ParamFile::from_toml_str_with_columns(start_text, start_name)
         .map(|(_, c)| c)
         .unwrap_or_default();

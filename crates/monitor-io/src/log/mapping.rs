@@ -252,6 +252,8 @@ pub struct MappedChannel {
     /// The channel's place among a line's fields (or the file's columns), from 0, when it
     /// is given by place (`column = N` in `[columns]`, N from 1) rather than by name.
     pub position: Option<usize>,
+    /// Its sign is turned (`invert = true`).
+    pub invert: bool,
 }
 
 /// Slowest and fastest sample rate `t_s = { sample_rate_hz = ... }` may give [Hz].
@@ -370,6 +372,7 @@ impl ColumnMapping {
             name: name.to_string(),
             unit,
             position: None,
+            invert: false,
         });
         Ok(())
     }
@@ -399,13 +402,42 @@ impl ColumnMapping {
         self.pole_pairs
     }
 
+    /// Turns the sign of column `c`'s channel (`invert = true`), mapping it by its schema
+    /// name where nothing maps it yet.
+    ///
+    /// # Errors
+    /// As [`ColumnMapping::set`]; the time column's sign cannot be turned.
+    pub fn set_invert(&mut self, c: Column) -> Result<(), ColumnsError> {
+        if c == Column::Time {
+            return Err(ColumnsError::InvertTime);
+        }
+        if self.get(c).is_none() {
+            self.set(c, c.name(), None)?;
+        }
+        if let Some(m) = self.channels[c as usize].as_mut() {
+            m.invert = true;
+        }
+        Ok(())
+    }
+
+    /// Whether column `c`'s sign is turned.
+    pub fn inverted(&self, c: Column) -> bool {
+        self.get(c).is_some_and(|m| m.invert)
+    }
+
     /// The factors to SI of every column (in [`Column::ALL`] order) for the `units` the
-    /// channels are recorded in (`None`: SI).
+    /// channels are recorded in (`None`: SI), negative for a column whose sign is turned.
     pub(super) fn factors(
         &self,
         units: &[Option<ChannelUnit>; Column::COUNT],
     ) -> [f64; Column::COUNT] {
-        units.map(|u| u.map_or(1.0, |u| u.factor(self.pole_pairs)))
+        let mut f = units.map(|u| u.map_or(1.0, |u| u.factor(self.pole_pairs)));
+        for (k, c) in Column::ALL.iter().enumerate() {
+            if self.inverted(*c) {
+                f[k] = -f[k];
+            }
+        }
+        f
     }
 }
 
@@ -486,6 +518,7 @@ impl ColumnMapping {
                 (None, Some(n)) if n >= 1 => m.set_position(*c, n as usize - 1, unit)?,
                 (None, Some(_)) => return Err(ColumnsError::ColumnZero(key.clone())),
                 (Some(_), Some(_)) => return Err(ColumnsError::NameAndColumn(key.clone())),
+                (None, None) if e.invert.is_some() => m.set(*c, c.name(), unit)?,
                 (None, None) => {
                     return Err(ColumnsError::NoChannel {
                         key: key.clone(),
@@ -494,6 +527,7 @@ impl ColumnMapping {
                 }
             }
         }
+        m.invert_from(table)?;
         // A column left out keeps its schema name: no mapped column may take it.
         for (i, a) in Column::ALL.iter().enumerate() {
             if let Some(b) = Column::ALL[i + 1..]
@@ -508,6 +542,22 @@ impl ColumnMapping {
             }
         }
         Ok(m)
+    }
+}
+
+impl ColumnMapping {
+    /// Turns the signs the `[columns]` table's `invert = true` entries ask for.
+    fn invert_from(&mut self, table: &ColumnsTable) -> Result<(), ColumnsError> {
+        for (key, e) in table {
+            let c = Column::ALL.iter().find(|c| c.name() == key.as_str());
+            if let (Some(c), Some(true)) = (c, e.invert) {
+                self.set_invert(*c).map_err(|why| ColumnsError::Key {
+                    key: key.clone(),
+                    source: Box::new(why),
+                })?;
+            }
+        }
+        Ok(())
     }
 }
 

@@ -134,6 +134,11 @@ pub struct ColumnEntry {
     /// (instead of `name` or `column`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sample_rate_hz: Option<f64>,
+    /// The channel's sign is turned (a current transformer or a voltage probe mounted the
+    /// other way, an encoder counting backwards): `ia_A.invert = true`, with or without a
+    /// `name` (without one, the schema's name).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub invert: Option<bool>,
 }
 
 /// The `[columns]` table: schema column name to [`ColumnEntry`].
@@ -151,6 +156,7 @@ pub fn columns_entries_toml(table: &ColumnsTable) -> String {
             c.unit.as_deref().map(|u| format!("unit = {}", quoted(u))),
             c.sample_rate_hz
                 .map(|r| format!("sample_rate_hz = {}", toml::Value::Float(r))),
+            c.invert.map(|i| format!("invert = {i}")),
         ]
         .into_iter()
         .flatten()

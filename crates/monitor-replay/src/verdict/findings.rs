@@ -60,6 +60,17 @@ pub(crate) fn isolation_name(
     }
 }
 
+/// Whether the isolation's equations departed from its baseline in a way it names no fault
+/// for and heating does not explain.
+fn deviates_unexplained(iso: &IsolationReport) -> bool {
+    use monitor_core::IsolationState;
+    matches!(
+        iso.state,
+        IsolationState::Isolated | IsolationState::Unknown
+    ) && iso.named.is_none()
+        && !iso.heating_explains
+}
+
 /// Why the parameter file does not fit the log (JSON `{"kind": ..}`).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -181,6 +192,14 @@ impl Stages<'_> {
         if let Some(why) = self.operating_point_explains(inp, lit_end) {
             return of(State::Explained, why);
         }
+        if against == Against::ParameterFile && deviates_unexplained(iso) {
+            // Against the file's nominal values, a change the isolation's steady-state
+            // equations saw beyond the healthy spread, that names no fault and that heating
+            // does not explain, is no "clear": a fault present from the first sample and a
+            // file off the machine look the same there (the parameter fit says which it
+            // cannot tell).
+            return of(State::Unexplained, Detail::Isolation);
+        }
         if !inp.detected && !lit_end {
             return of(State::Clear, Detail::Isolation);
         }
@@ -291,7 +310,13 @@ impl Stages<'_> {
         let outside = self.lamps.commission.moved_note(out);
         let rise_k = iso.winding_rise_k;
         if outside.is_none() && load_moves == 0 && rise_k.is_none() {
-            return of(State::Clear, Detail::Steady);
+            // "No heating" only where the isolation read the windings at a steady point.
+            let detail = if iso.state == monitor_core::IsolationState::NotJudged {
+                Detail::NoLoadMoveHeatingUnread
+            } else {
+                Detail::Steady
+            };
+            return of(State::Clear, detail);
         }
         of(
             State::Explained,

@@ -18,6 +18,7 @@
 //!   commissioned.
 
 pub(super) mod findings;
+pub mod machine_fit;
 pub(super) mod measured;
 
 use monitor_core::verdict::{decide, Finding, NamedFault, Size, State};
@@ -88,6 +89,9 @@ pub enum Detail {
     OperatingPointUnavailable,
     /// Steady: no load move, no heating.
     Steady,
+    /// No load move; the heating not judged: the isolation never judged a steady
+    /// operating point with voltage, so the windings' temperature was not read.
+    NoLoadMoveHeatingUnread,
     /// The operating point moved.
     OperatingPointMoved {
         /// Outside the commissioned range at the end: what left it.
@@ -105,6 +109,9 @@ pub enum Detail {
     FileFits,
     /// The parameter file does not fit this log, and why.
     FileMisfit(FileMisfit),
+    /// The full-order machine fitted to the log against the file: a fault present from the
+    /// start named, or the machine on the file (the reach of a "healthy").
+    MachineFit(machine_fit::MachineFit),
     /// The data-quality stage does not trust the data (the report's
     /// `data_quality.not_trusted_because`).
     DataNotTrusted,

@@ -287,7 +287,8 @@ pub fn indicator_trend(
 }
 
 /// The indicator's points, normalised with `fit` where there is one: those from `start_s`
-/// on in the window, those of the reference mask (over `rows`) in the reference.
+/// on in the window, those of the reference mask (over `rows`) in the reference unless
+/// they stand at the indicator's FAULT level.
 fn series_of(
     ind: &Indicator,
     covs: &[&str],
@@ -295,6 +296,7 @@ fn series_of(
     (rows, reference): (&[&StoredRow], &[bool]),
     start_s: f64,
 ) -> Vec<TrendPoint> {
+    let common = super::level::fault_level_of(ind, rows);
     rows.iter()
         .zip(reference)
         .filter_map(|(r, in_reference)| {
@@ -312,7 +314,10 @@ fn series_of(
                 value,
                 normalised,
                 in_window: t >= start_s - 1.0,
-                in_reference: *in_reference,
+                // A log at the indicator's FAULT level is no healthy reference for it,
+                // whatever its verdict said (a fault growing under the thresholds of a
+                // log judged alone).
+                in_reference: *in_reference && !super::level::at_fault_level(ind, r, common),
             })
         })
         .collect()

@@ -45,6 +45,17 @@ pub(super) fn fault_level_run(ind: &Indicator, rows: &[&StoredRow]) -> Option<Le
     })
 }
 
+/// Whether the log `r` stands at the FAULT level of `ind` (its own level column's value,
+/// else `common`, the indicator's level over the motor's logs): such a log is no healthy
+/// reference for that indicator, whatever its verdict said.
+pub(super) fn at_fault_level(ind: &Indicator, r: &StoredRow, common: Option<f64>) -> bool {
+    let level = match ind.fault_level {
+        FaultLevel::Column(c) => r.f64(c).filter(|x| *x > 0.0).or(common),
+        _ => common,
+    };
+    matches!((r.f64(ind.column), level), (Some(v), Some(l)) if v.is_finite() && v >= l)
+}
+
 /// The indicator's FAULT level for these rows, where it has one.
 pub(super) fn fault_level_of(ind: &Indicator, rows: &[&StoredRow]) -> Option<f64> {
     match ind.fault_level {

@@ -195,12 +195,12 @@ pub enum ReferenceBasis {
         /// The marked UTC day.
         until_day: String,
     },
-    /// The motor's first `days` days of logs whose verdict is not FAULT.
+    /// The motor's first `days` days of logs whose verdict is healthy or watching.
     FirstHealthyDays {
         /// The days [days].
         days: f64,
     },
-    /// Its first `logs` logs whose verdict is not FAULT (its first days hold fewer).
+    /// Its first `logs` logs whose verdict is healthy or watching (its first days hold fewer).
     FirstHealthyLogs {
         /// The logs.
         logs: usize,

@@ -16,12 +16,17 @@ const DAY_S: f64 = 86_400.0;
 /// The motor's reference among `rows` (one motor's, by time): a mask over `rows` and what
 /// it is. With [`TrendOptions::reference_until_s`], the logs before it (all of them: the
 /// user marked them healthy); else the logs of the motor's first
-/// [`TrendOptions::window_days`] whose stored verdict is not `fault`, or its first
-/// [`TrendOptions::min_logs`] such logs where the first days hold fewer; where every log's
-/// verdict is `fault`, its first days' logs whatever their verdict (and [`TrendReference::basis`] says so).
+/// [`TrendOptions::window_days`] whose stored verdict is `healthy` or `watching` (neither a
+/// FAULT nor a log that could not judge), or its first [`TrendOptions::min_logs`] such logs
+/// where the first days hold fewer; where no log's verdict is either, its first days' logs
+/// whatever their verdict (and [`TrendReference::basis`] says so). Per indicator, a log at
+/// the indicator's FAULT level is left out of its reference whatever its verdict.
 pub fn reference_rows(rows: &[&StoredRow], opts: &TrendOptions) -> (Vec<bool>, TrendReference) {
     let time = |r: &StoredRow| r.f64("log_time_s").unwrap_or_default();
-    let healthy = |r: &StoredRow| r.str("verdict") != Some("fault");
+    // A log that judged the motor and found no fault: healthy, or watching a change below
+    // a FAULT. Neither a FAULT nor a log that could not judge (a file that does not fit, a
+    // wiring mix-up, a supply off the file's) is a healthy reference.
+    let healthy = |r: &StoredRow| matches!(r.str("verdict"), Some("healthy" | "watching"));
     let marked = opts.reference_until_s.map(|u| u as f64);
     let marked_day = |u: f64| utc_day(u as i64 - 1);
     let (mask, basis, is_marked, mark_without_logs) = match marked {
@@ -77,12 +82,7 @@ fn first_healthy(
         taken += usize::from(*m);
     }
     if taken > 0 {
-        return (
-            mask,
-            ReferenceBasis::FirstHealthyLogs {
-                logs: opts.min_logs,
-            },
-        );
+        return (mask, ReferenceBasis::FirstHealthyLogs { logs: taken });
     }
     (
         rows.iter().map(|r| early(r)).collect(),

@@ -53,6 +53,9 @@ fn summary_of(detail: &Detail, rep: &DiagnoseReport, sp: &dyn Spelling) -> Strin
             "the load and the heating need the voltages and the speed".into()
         }
         Detail::Steady => "steady: no load move, no heating".into(),
+        Detail::NoLoadMoveHeatingUnread => {
+            "no load move; the heating not read (no steady operating point with voltage was judged)".into()
+        }
         Detail::OperatingPointMoved {
             outside,
             load_moves,
@@ -72,9 +75,11 @@ fn summary_of(detail: &Detail, rep: &DiagnoseReport, sp: &dyn Spelling) -> Strin
                 ));
             }
             if let Some(rise) = rise_k {
-                said.push(format!(
-                    "the windings warmed by {rise:.0} K since commissioning"
-                ));
+                said.push(if commissioned(rep) {
+                    format!("the windings warmed by {rise:.0} K since commissioning")
+                } else {
+                    format!("the windings are about {rise:.0} K warmer than the parameter file assumes")
+                });
             }
             said.join("; ")
         }
@@ -87,9 +92,11 @@ fn summary_of(detail: &Detail, rep: &DiagnoseReport, sp: &dyn Spelling) -> Strin
                 .into()
         }
         Detail::FileMisfit(m) => format!(
-            "the parameter file does not fit this log (commission on the healthy motor, or identify it: sim-host identify): {}",
+            "the parameter file does not fit this log, or a fault was there from its start: the two look the same here \
+             (commission on the healthy motor, or identify it from a healthy log): {}",
             file_misfit(m, rep, sp)
         ),
+        Detail::MachineFit(f) => super::machine_fit::summary(f),
         Detail::DataNotTrusted => format!(
             "data quality: {}",
             rep.data_quality.not_trusted_because.join("; ")
@@ -132,6 +139,14 @@ fn summary_of(detail: &Detail, rep: &DiagnoseReport, sp: &dyn Spelling) -> Strin
             summary_of(read, rep, sp)
         ),
     }
+}
+
+/// Whether the residuals were judged against a commissioned baseline.
+fn commissioned(rep: &DiagnoseReport) -> bool {
+    rep.findings.iter().any(|f| {
+        f.source() == FindingSource::Residuals
+            && f.finding.against == monitor_core::verdict::Against::Commissioning
+    })
 }
 
 /// Why the parameter file does not fit the log.
@@ -181,16 +196,19 @@ pub fn brief(f: &FindingReport, rep: &DiagnoseReport, sp: &dyn Spelling) -> Stri
                 residuals()
             )
         }
-        Detail::Isolation | Detail::LampsOutOfRange { .. } => residuals(),
+        Detail::Isolation => format!("{}{}", residuals(), super::machine_fit::reach(rep, against)),
+        Detail::LampsOutOfRange { .. } => residuals(),
         Detail::Winding => winding::brief(&rep.unbalance, against, sp),
         Detail::Rotor => rotor::brief(&rep.rotor),
-        Detail::OperatingPointUnavailable | Detail::Steady | Detail::OperatingPointMoved { .. } => {
-            "operating point".into()
-        }
+        Detail::OperatingPointUnavailable
+        | Detail::Steady
+        | Detail::NoLoadMoveHeatingUnread
+        | Detail::OperatingPointMoved { .. } => "operating point".into(),
         Detail::Commissioned
         | Detail::ParameterFitUnavailable
         | Detail::FileFits
-        | Detail::FileMisfit(_) => "parameter file".into(),
+        | Detail::FileMisfit(_)
+        | Detail::MachineFit(_) => "parameter file".into(),
         Detail::DataNotTrusted
         | Detail::DataNotJudged { .. }
         | Detail::DataClean

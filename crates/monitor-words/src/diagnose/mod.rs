@@ -11,6 +11,7 @@
 mod commissioning;
 mod findings;
 mod isolation;
+pub mod machine_fit;
 mod named;
 mod rotor;
 mod verdict;
@@ -29,7 +30,7 @@ pub use verdict::{
 };
 pub use winding::{
     describe_against, line as winding_line, operating_point_source, phase_not_judged, reach,
-    shorted_turns, summary as winding_summary, suspect, widened, CREW_SHORT,
+    sequence_ratio, shorted_turns, summary as winding_summary, suspect, widened, CREW_SHORT,
 };
 
 use monitor_replay::{DiagnoseReport, MonitorState, MovedWhy};
@@ -176,6 +177,28 @@ fn put(v: &mut Value, key: &str, value: impl Into<Value>) {
     }
 }
 
+/// A first detection of the lamps' signature matching as the report's events list it,
+/// beside the verdict: the fault the verdict names, or why the verdict does not name it
+/// (the lamps' four residuals carry two equations' worth: Table 1 shares a row between
+/// faults the isolation's equations tell apart). JSON `detections_said`.
+pub fn detection_line(d: &monitor_replay::Detection, rep: &DiagnoseReport) -> String {
+    use monitor_core::verdict::FaultName;
+    let head = format!(
+        "{:.2} s  the lamps' signature first matched {}",
+        d.t_s,
+        d.fault.name()
+    );
+    let named = rep.verdict_finding.as_ref().and_then(|f| f.named());
+    match named.map(|n| n.fault) {
+        Some(FaultName::Table1(f)) if f == d.fault => head,
+        Some(_) => format!(
+            "{head}; a candidate dropped: the lamps alone share it with other faults, the verdict names {}",
+            named.map_or(String::new(), fault_text)
+        ),
+        None => format!("{head}; a candidate dropped: the verdict names no fault"),
+    }
+}
+
 /// `diagnose --json`'s document of `rep`: its typed values, and beside each its sentence
 /// under the key the document has always had, in `sp`'s words.
 pub fn document(rep: &DiagnoseReport, sp: &dyn Spelling) -> Value {
@@ -196,6 +219,14 @@ fn put_story(v: &mut Value, rep: &DiagnoseReport, story: &Story, sp: &dyn Spelli
         story.withheld_because.clone(),
     );
     put(v, "skipped", story.skipped.clone());
+    put(
+        v,
+        "detections_said",
+        rep.detections
+            .iter()
+            .map(|d| detection_line(d, rep))
+            .collect::<Vec<_>>(),
+    );
     if let Some(fs) = v.get_mut("findings").and_then(Value::as_array_mut) {
         for (f, (s, _)) in fs.iter_mut().zip(&story.findings) {
             put(f, "summary", s.clone());

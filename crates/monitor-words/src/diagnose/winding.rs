@@ -196,6 +196,18 @@ pub fn reach(r: &TurnReach) -> String {
     )
 }
 
+/// A negative-sequence ratio `|I2|/|I1|` as a measurement (`12.50 %`), or, above 100 %,
+/// why it is none: the negative sequence is the larger, so the currents turn backwards
+/// against the sequence judged (two channels exchanged, the data-quality finding says
+/// which), which no unbalance of a running motor makes.
+pub fn sequence_ratio(ratio: f32) -> String {
+    if ratio.is_finite() && ratio <= 1.0 {
+        format!("{:.2} %", 100.0 * ratio)
+    } else {
+        "not measured (the negative sequence exceeds the positive: the phase order is reversed, wiring, not an unbalance)".to_string()
+    }
+}
+
 /// The suspect phase as the unbalance line gives it: `c (probability 0.72)`, `c, watched
 /// (probability 0.39, below the 0.50 a FAULT needs)`, or `none`.
 pub fn suspect(u: &UnbalanceReport) -> String {

@@ -197,19 +197,24 @@ fn events_list(h: &mut String, rep: &DiagnoseReport) {
         .iter()
         .map(|e| (e.t_s(), words::event_line(e).trim().to_string()))
         .collect();
-    lines.extend(rep.detections.iter().map(|d| {
-        (
-            d.t_s,
-            format!(
-                "{:.2} s  the lamps' signature first matched {} (the verdict above weighs it)",
-                d.t_s,
-                d.fault.name()
-            ),
-        )
-    }));
+    lines.extend(
+        rep.detections
+            .iter()
+            .map(|d| (d.t_s, words::detection_line(d, rep))),
+    );
     lines.sort_by(|a, b| a.0.total_cmp(&b.0));
     let lines: Vec<String> = lines.into_iter().map(|(_, l)| l).collect();
     list(h, "Events (marked on the charts above)", &lines);
+}
+
+/// A negative-sequence ratio in per cent where it is a measurement (at most 100 %: above
+/// it the phase order is reversed, `words::sequence_ratio`), else not drawn (NaN).
+fn measured_pct(ratio: f32) -> f64 {
+    if ratio <= 1.0 {
+        100.0 * f64::from(ratio)
+    } else {
+        f64::NAN
+    }
 }
 
 /// The negative sequence: the whole log's ratio, the named phase and its confidence.
@@ -218,8 +223,8 @@ fn winding(h: &mut String, rep: &DiagnoseReport) {
     let phase = words::suspect(u);
     let _ = write!(
         h,
-        "<h2>Winding</h2><p>Negative sequence |I2|/|I1| = {:.2} % (least change that names a phase {:.1} %); suspect phase: {}.</p>",
-        100.0 * u.negative_sequence_ratio,
+        "<h2>Winding</h2><p>Negative sequence |I2|/|I1| = {} (least change that names a phase {:.1} %); suspect phase: {}.</p>",
+        esc(&words::sequence_ratio(u.negative_sequence_ratio)),
         100.0 * u.least_change,
         esc(&phase)
     );
@@ -351,6 +356,7 @@ fn residuals_chart(rep: &DiagnoseReport) -> Chart<'static> {
             line(&format!("r{}", k + 1), pts, k, false)
         })
         .collect();
+    series.extend(threshold_lines(rep));
     let hi = series
         .iter()
         .flat_map(|s| s.points.iter().map(|p| p.1.abs()))
@@ -361,11 +367,42 @@ fn residuals_chart(rep: &DiagnoseReport) -> Chart<'static> {
         rep,
         (
             "residuals",
-            "Residuals r1..r4 over time, events marked",
+            "Residuals r1..r4 over time with their threshold bands (dashed), events marked",
             "residual [% of nominal]",
         ),
         series,
     )
+}
+
+/// The residuals' threshold bands in force at the log's end (`threshold_bands`), dashed in
+/// grey (one legend entry, a colour of its own): each band's two edges from where it came
+/// into force (the commissioning window's end, else the log's first point) to the log's
+/// end. A residual outside its band lights its lamp: the chart shows why r1 lit and r2 did
+/// not (the fixed bands are one, +/-3 %; the learned ones each residual's own).
+fn threshold_lines(rep: &DiagnoseReport) -> Vec<Series> {
+    let (Some(bands), Some(first), Some(last)) =
+        (rep.threshold_bands, rep.timeline.first(), rep.timeline.last())
+    else {
+        return Vec::new();
+    };
+    let from = rep
+        .commissioning
+        .window
+        .filter(|_| {
+            matches!(
+                rep.commissioning.thresholds,
+                monitor_api::replay::Thresholds::Learned { .. }
+            )
+        })
+        .map_or(first.t_s, |w| w[1].max(first.t_s));
+    let mut pts = Vec::new();
+    for [c, w] in bands {
+        for edge in [c - w, c + w] {
+            let y = 100.0 * f64::from(edge);
+            pts.extend([(from, y), (last.t_s, y), (f64::NAN, f64::NAN)]);
+        }
+    }
+    vec![line("threshold bands r1..r4", pts, 5, true)]
 }
 
 /// The lamps r1..r4 and the monitor's state over time: one row each, high where lit.
@@ -421,13 +458,13 @@ fn sequence_chart(rep: &DiagnoseReport) -> Chart<'static> {
         let pts = rep
             .timeline
             .iter()
-            .map(|p| (p.t_s, 100.0 * f64::from(p.negative_sequence_ratio)))
+            .map(|p| (p.t_s, measured_pct(p.negative_sequence_ratio)))
             .collect();
         (pts, "|I2|/|I1|".to_string())
     };
     let mut seg = Vec::new();
     for s in &rep.unbalance.segments {
-        let y = 100.0 * f64::from(s.negative_sequence_ratio);
+        let y = measured_pct(s.negative_sequence_ratio);
         seg.extend([(s.from_s, y), (s.to_s, y), (f64::NAN, f64::NAN)]);
     }
     let drawn = !pts.is_empty() || !seg.is_empty();

@@ -150,7 +150,7 @@ fn ladder_html(log: &str, r: &LadderReport, charts: &[(String, String)]) -> Stri
         let _ = write!(h, "<h3>{}</h3>{svg}", esc(title));
     }
     h.push_str("<table><tr><th>step</th><th class=l>change</th><th>error</th><th>x floor</th><th>held-back</th><th>x floor</th><th>explained (whole / held-back)</th><th class=l>fitted (physical range)</th></tr>");
-    let _ = write!(h, "<tr><td>0</td><td class=l>{}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{:.1}</td><td></td><td></td></tr>", esc(&start), r.start.error, r.start.ratio_to_floor, r.start.heldback_error, r.start.heldback_error / r.start.heldback_noise_floor);
+    let _ = write!(h, "<tr><td>0</td><td class=l>{}</td><td>{:.4}</td><td>{}</td><td>{:.4}</td><td>{}</td><td></td><td></td></tr>", esc(&start), r.start.error, super::times_floor(r.start.ratio_to_floor), r.start.heldback_error, super::times_floor(r.start.heldback_error / r.start.heldback_noise_floor));
     for (k, s) in r.ladder.iter().enumerate() {
         ladder_row(&mut h, k + 1, s);
     }
@@ -248,12 +248,12 @@ fn ladder_row(h: &mut String, k: usize, s: &LadderStep) {
     for d in &s.dropped {
         name.push_str(&format!(", {d} removed"));
     }
-    let _ = write!(h, "<tr><td>{}</td><td class=l>{}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{:.1}</td><td>{:.0} % / {:.0} %</td><td class=l>{}</td></tr>", k, esc(&name), s.error, s.ratio_to_floor, s.heldback_error, s.heldback_ratio_to_floor, 100.0 * s.explained, 100.0 * s.heldback_explained, esc(&fitted.join("; ")));
+    let _ = write!(h, "<tr><td>{}</td><td class=l>{}</td><td>{:.4}</td><td>{}</td><td>{:.4}</td><td>{}</td><td>{:.0} % / {:.0} %</td><td class=l>{}</td></tr>", k, esc(&name), s.error, super::times_floor(s.ratio_to_floor), s.heldback_error, super::times_floor(s.heldback_ratio_to_floor), 100.0 * s.explained, 100.0 * s.heldback_explained, esc(&fitted.join("; ")));
 }
 
 /// The table row of the chosen model refitted on the whole log.
 fn ladder_end_row(h: &mut String, f: &FinalFit) {
-    let _ = write!(h, "<tr><td>end</td><td class=l>the chosen model refitted on the whole log</td><td>{:.4}</td><td>{:.1}</td><td></td><td></td><td></td><td class=l>{}</td></tr>", f.error, f.ratio_to_floor, esc(&super::end_base(f)));
+    let _ = write!(h, "<tr><td>end</td><td class=l>the chosen model refitted on the whole log</td><td>{:.4}</td><td>{}</td><td></td><td></td><td></td><td class=l>{}</td></tr>", f.error, super::times_floor(f.ratio_to_floor), esc(&super::end_base(f)));
 }
 
 fn esc(s: &str) -> String {

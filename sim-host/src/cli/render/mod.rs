@@ -18,6 +18,20 @@ pub mod plot;
 pub mod text;
 pub mod trend_plot;
 
+/// A multiple of the noise floor as the ladder's tables print it (`12.3x`); beyond 999x (a
+/// noise-free log's floor is next to nothing) `>999x`, the ratio saying no more there; `-`
+/// where no error was measured (the model could not run). The text and the HTML report
+/// print it alike.
+pub(super) fn times_floor(r: f64) -> String {
+    if !r.is_finite() {
+        "-".into()
+    } else if r < 999.5 {
+        format!("{r:.1}x")
+    } else {
+        ">999x".into()
+    }
+}
+
 /// The base parameters of the ladder's end (`f`, the chosen model refitted on the whole
 /// log) in a table cell: the changes named, or "base parameters as the file's".
 pub fn end_base(f: &monitor_api::analysis::FinalFit) -> String {

@@ -51,6 +51,9 @@ pub enum ColumnsError {
     /// `sample_rate_hz` and a time column both given.
     #[error("{0}: sample_rate_hz says the log has no time column; give either it or the time column (name or column, with its unit), not both")]
     RateAndTimeColumn(String),
+    /// `invert` given to the time column.
+    #[error("t_s: invert = true turns a channel's sign; the time's cannot be turned")]
+    InvertTime,
     /// `column = 0`.
     #[error("{0}: column = 0; the fields of a line are counted from 1")]
     ColumnZero(String),

@@ -84,7 +84,10 @@ impl<S: CleanSink> QualityStage<'_, S> {
         let scale = f_cur.map_or(1.0, |f| f / self.limits.supply_hz);
         self.q.speed_unit = speed.finding(f_cur.is_some(), scale, self.limits.pole_pairs);
         self.q.timestamp_jitter_rms_s = (self.jitter.0 / self.jitter.1.max(1) as f64).sqrt();
-        self.q.wiring = wiring.findings();
+        self.q.wiring = wiring.findings(&super::wiring::WiringContext {
+            omega_dt: f_cur.map(|f| std::f64::consts::TAU * f / self.q.sample_rate_hz.max(1.0)),
+            sync_rad_s: self.limits.sync_rad_s,
+        });
         self.q.encoder_wraps = self.encoder.wraps;
         self.q.encoder_resets = self.encoder.resets;
         self.q.clipped = clips

@@ -53,7 +53,8 @@
 //!
 //! **Supply frequency.** The median period of the phase-a current's zero crossings is
 //! compared with the parameter file's supply frequency; a difference over
-//! [`SUPPLY_MISMATCH`] is a warning (a V/f drive running below base speed also gives one).
+//! [`SUPPLY_MISMATCH`] is not trusted: the verdict is withheld, since the monitor's model
+//! runs at the file's frequency (a V/f drive running below base speed also gives one).
 //!
 //! **Trust.** [`DataQuality::trusted`] is false when more than [`MAX_BAD_FRACTION`] of
 //! the rows were dropped or held out, the timestamps are irregular on more than
@@ -93,8 +94,8 @@ pub const RATE_CHANGE_RUN: usize = 64;
 /// Samples per supply period below which no analysis is possible (the core's limit,
 /// `MonitorConfig::validate`).
 pub const MIN_SAMPLES_PER_PERIOD: f64 = 8.0;
-/// Relative difference between the current's frequency and the supply frequency that is
-/// warned about.
+/// Relative difference between the current's frequency and the parameter file's supply
+/// frequency beyond which the log is not trusted (the verdict withheld).
 pub const SUPPLY_MISMATCH: f64 = 0.05;
 /// Fraction of rows dropped or held out (or of intervals irregular) beyond which no
 /// verdict is given.

@@ -167,7 +167,8 @@ impl Signals {
         if h.shape & 2 != 0 {
             self.speed.push_all(&h.wm[..n]);
         }
-        self.wiring.push_block(v, i);
+        let w = (h.shape & 2 != 0).then(|| &h.wm[..n]);
+        self.wiring.push_block(v, i, w);
     }
 
     /// A row with bad cells (`good(c)`: the cell of `c` is good): its good cells count for
@@ -243,7 +244,11 @@ mod tests {
         assert_eq!(cc2.median_period(), cc.median_period());
         assert!(cc.median_period().is_some_and(|p| (p - 0.02).abs() < 1e-3));
         assert_eq!(s2.median_ratio(), speed.median_ratio());
-        assert_eq!(w2.findings(), wiring.findings());
+        let ctx = super::super::wiring::WiringContext {
+            omega_dt: Some(std::f64::consts::TAU * 50.0 * 1e-4),
+            sync_rad_s: 157.0,
+        };
+        assert_eq!(w2.findings(&ctx), wiring.findings(&ctx));
         assert_eq!(format!("{w2:?}"), format!("{wiring:?}"));
     }
 }

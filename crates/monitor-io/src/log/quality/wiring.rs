@@ -1,92 +1,165 @@
-//! Duplicated and swapped channels ([`WiringCheck`]): what a DAQ's wiring or a spreadsheet
-//! does to a log.
+//! The channels' wiring ([`WiringCheck`]): what a DAQ's wiring, a current transformer
+//! mounted the other way or a spreadsheet does to a log, judged before any verdict.
 //!
 //! - **Duplicated.** Two phase channels of one set (two currents, two voltages) that hold
 //!   the same reading on more than [`DUPLICATE_SHARE`] of the rows where they alternate: one
 //!   column was copied over another, or two inputs read the same sensor. A balanced
 //!   three-phase set never has two phases equal for more than an instant per period.
-//! - **Swapped.** The direction in which the space vector turns (the sign of the cross
-//!   product of consecutive Clarke vectors, `alpha_k beta_{k+1} - beta_k alpha_{k+1}`) is
-//!   the phase order. Currents turning the other way than the voltages on more than
-//!   [`SWAPPED_SHARE`] of the rows where both turn is two phases swapped in one set: the
-//!   machine cannot draw a negative-sequence current from a positive-sequence supply.
+//! - **One channel reversed.** The three currents of a star without neutral sum to zero
+//!   whatever the machine does, and so do the phase voltages against the star point. A
+//!   sum whose RMS exceeds a phase's ([`ZERO_SEQUENCE_SUSPECT`]) and falls by
+//!   [`ZERO_SEQUENCE_FIXED`] or more with one channel's sign turned is that channel reversed
+//!   (a sensor's polarity: one reversed current makes the sum twice that phase).
+//! - **The phase order.** From the moments of the rows (no frequency needed): the complex
+//!   power of the Clarke vectors `S = mean(V conj(I)) = P + jQ`, the vectors' mean squares
+//!   and the current vector's turn from one row to the next (`alpha_k beta_{k+1} -
+//!   beta_k alpha_{k+1}`, over `|I|^2 sin(w dt)`: +1 for a positive sequence, -1 for a
+//!   negative one). Currents and voltages of one sequence give `|S|` about `|V| |I|`; of
+//!   opposite sequences (two channels of one set exchanged) almost nothing
+//!   ([`COHERENCE_MISMATCH`]). An induction machine always draws magnetising current, so
+//!   `Q` has the sign of the sequence, and a motor's power-factor angle `arg S` lies
+//!   between 0 and 90 degrees: currents whose angle falls a third of a turn away
+//!   ([`ROTATED_OUTSIDE_DEG`]) are rotated one phase against the voltages. The shaft's
+//!   direction (the speed channel's mean) says which way is forward: both sets turning
+//!   against it is a phase pair exchanged in both (or a motor run backwards), both with it
+//!   but the speed negative is the speed channel's sign.
 //!
-//! Either finding withholds the verdict (the report's `wiring` lines say which).
+//! Each finding is a [`WiringFault`] with the column mapping that fixes it
+//! ([`WiringFault::fix`]: the parameter file's `[columns]` entries), and withholds the
+//! verdict: a log whose channels are not what their names say names no fault.
 
 use crate::log::Row;
 
 /// Share of the alternating rows on which two channels must be equal to be duplicates.
 pub const DUPLICATE_SHARE: f64 = 0.5;
-/// Share of the turning rows on which the currents must turn against the voltages to be
-/// swapped.
-pub const SWAPPED_SHARE: f64 = 0.8;
+/// RMS of a set's sum over the RMS of one of its phases above which a channel may be
+/// reversed (one reversed current gives 2; a healthy set a few hundredths).
+pub const ZERO_SEQUENCE_SUSPECT: f64 = 1.0;
+/// The factor by which one channel's sign turned must bring the sum's RMS down for that
+/// channel to be named reversed (a common-mode voltage of a PWM inverter measured against
+/// the DC link's midpoint makes the sum large too, but no single channel's sign removes it;
+/// the real recordings of `examples/recordings/itsc` sum to 0.58 of a phase as published,
+/// 1.93 with one current reversed).
+pub const ZERO_SEQUENCE_FIXED: f64 = 2.5;
+/// `|S| / sqrt(mean|V|^2 mean|I|^2)` below which the currents and the voltages turn
+/// opposite ways (one sequence against the other: 0.01-0.05 on simulated logs); one
+/// sequence gives 0.6-1 (less where a PWM voltage's harmonics fill `mean|V|^2`).
+pub const COHERENCE_MISMATCH: f64 = 0.25;
+/// Least `|r|`, the current vector's mean turn over `mean|I|^2 sin(w dt)` (+1 for a pure
+/// positive sequence, -1 for a negative one), for its direction to be judged.
+pub const DIRECTION_MIN: f64 = 0.3;
+/// The power-factor angle outside of which (below minus this, above 90 + this degrees)
+/// the currents are judged rotated against the voltages when a third of a turn puts them
+/// inside a motor's 0..90 degrees.
+pub const ROTATED_OUTSIDE_DEG: f64 = 30.0;
+/// The speed channel's mean, as a fraction of the synchronous speed, beyond which it gives
+/// the shaft's direction.
+pub const SHAFT_MIN: f64 = 0.05;
 /// Rows a finding needs before it is said.
 const MIN_ROWS: u64 = 1000;
 
-/// The counts of the checks; see the module documentation.
-#[derive(Debug, Clone, Default)]
+mod fault;
+pub use fault::{serialize_all, ColumnFix, PhaseSet, WiringFault};
+
+/// What the stage knows at the end that the check reads: the supply's angle per sample
+/// (`w dt`, from the current's zero crossings and the sample rate) and the machine's
+/// mechanical synchronous speed [rad/s].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WiringContext {
+    /// The supply's angle per sample [rad], where the currents alternate.
+    pub omega_dt: Option<f64>,
+    /// The mechanical synchronous speed at the file's frequency [rad/s].
+    pub sync_rad_s: f64,
+}
+
+/// First and second moments of a set of rows (uncentred sums; [`Moments::cov`] centres
+/// them).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Moments {
+    n: f64,
+    s: [f64; 3],
+    ss: [[f64; 3]; 3],
+}
+
+impl Moments {
+    #[inline(always)]
+    fn push(&mut self, x: [f64; 3]) {
+        self.n += 1.0;
+        for k in 0..3 {
+            self.s[k] += x[k];
+            for j in k..3 {
+                self.ss[k][j] += x[k] * x[j];
+            }
+        }
+    }
+
+    /// The covariance matrix.
+    fn cov(&self) -> [[f64; 3]; 3] {
+        let n = self.n.max(1.0);
+        let mut c = [[0.0; 3]; 3];
+        for k in 0..3 {
+            for j in k..3 {
+                let v = self.ss[k][j] / n - self.s[k] / n * self.s[j] / n;
+                c[k][j] = v;
+                c[j][k] = v;
+            }
+        }
+        c
+    }
+}
+
+/// Sums of products of two 3-vectors (`x_k y_j`), with the sums of each.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Cross {
+    n: f64,
+    sx: [f64; 3],
+    sy: [f64; 3],
+    sxy: [[f64; 3]; 3],
+}
+
+impl Cross {
+    #[inline(always)]
+    fn push(&mut self, x: [f64; 3], y: [f64; 3]) {
+        self.n += 1.0;
+        for k in 0..3 {
+            self.sx[k] += x[k];
+            self.sy[k] += y[k];
+            for j in 0..3 {
+                self.sxy[k][j] += x[k] * y[j];
+            }
+        }
+    }
+
+    /// The cross-covariance `cov(x_k, y_j)`.
+    fn cov(&self) -> [[f64; 3]; 3] {
+        let n = self.n.max(1.0);
+        let mut c = [[0.0; 3]; 3];
+        for k in 0..3 {
+            for j in 0..3 {
+                c[k][j] = self.sxy[k][j] / n - self.sx[k] / n * self.sy[j] / n;
+            }
+        }
+        c
+    }
+}
+
+/// The counts and moments of the checks; see the module documentation.
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct WiringCheck {
     /// Rows seen, and rows on which each pair (ab, bc, ca) of currents, then of voltages,
     /// read the same non-zero value.
     rows: u64,
     equal: [u64; 6],
-    /// Rows on which both vectors turned, and on which they turned opposite ways.
-    turning: u64,
-    opposite: u64,
-    last: Option<([f64; 2], [f64; 2])>,
-}
-
-/// Clarke's alpha and beta of a phase set.
-#[inline(always)]
-fn clarke(x: [f64; 3]) -> [f64; 2] {
-    let alpha = (2.0 * x[0] - x[1] - x[2]) / 3.0;
-    let beta = (x[1] - x[2]) / 3f64.sqrt();
-    [alpha, beta]
-}
-
-/// Rows whose Clarke vectors [`WiringCheck::push_block`] computes at a time.
-const CHUNK: usize = 64;
-
-/// Alpha and beta of up to [`CHUNK`] rows.
-type Clarke = [[f64; CHUNK]; 2];
-
-/// [`clarke`] of each row of a phase set given channel by channel (at most [`CHUNK`] rows).
-fn clarke_all(x: [&[f64]; 3]) -> Clarke {
-    let mut out = [[0.0; CHUNK]; 2];
-    let [a, b] = &mut out;
-    for ((((alpha, beta), x0), x1), x2) in
-        a.iter_mut().zip(b.iter_mut()).zip(x[0]).zip(x[1]).zip(x[2])
-    {
-        [*alpha, *beta] = clarke([*x0, *x1, *x2]);
-    }
-    out
-}
-
-/// Whether both vectors turned (the cross products of consecutive Clarke vectors), and
-/// whether they turned opposite ways, as counts.
-#[inline(always)]
-fn turn_counts(turn_i: f64, turn_v: f64) -> (u64, u64) {
-    let both = (turn_i != 0.0) & (turn_v != 0.0);
-    (
-        u64::from(both),
-        u64::from(both & ((turn_i > 0.0) != (turn_v > 0.0))),
-    )
-}
-
-/// The turns between consecutive rows of the first `m` rows of one chunk: rows on which
-/// both vectors turned, and on which they turned opposite ways.
-fn count_turns(ci: &Clarke, cv: &Clarke, m: usize) -> (u64, u64) {
-    let m = m.min(CHUNK);
-    let (ai, bi, av, bv) = (&ci[0][..m], &ci[1][..m], &cv[0][..m], &cv[1][..m]);
-    let (mut turning, mut opposite) = (0, 0);
-    for k in 1..m {
-        let turn_i = ai[k - 1] * bi[k] - bi[k - 1] * ai[k];
-        let turn_v = av[k - 1] * bv[k] - bv[k - 1] * av[k];
-        let (t, o) = turn_counts(turn_i, turn_v);
-        turning += t;
-        opposite += o;
-    }
-    (turning, opposite)
+    /// The currents' moments (every row), the voltages' (rows with voltages), the
+    /// voltages against the currents, the currents against the next row's.
+    i: Moments,
+    v: Moments,
+    vi: Cross,
+    lag: Cross,
+    /// The speed's sum and count.
+    w: (f64, f64),
+    /// The last row's currents, for the lag (none after a break).
+    last: Option<[f64; 3]>,
 }
 
 /// Adds to `equal` the rows on which each pair (ab, bc, ca) of `x` read the same non-zero
@@ -104,7 +177,120 @@ fn count_equal(equal: &mut [u64], x: [&[f64]; 3]) {
     }
 }
 
+/// A set's channels mapped: channel `k` of the mapped set is `sign[k]` times channel
+/// `perm[k]` of the logged one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Map {
+    perm: [usize; 3],
+    sign: [f64; 3],
+}
+
+const IDENTITY: Map = Map {
+    perm: [0, 1, 2],
+    sign: [1.0; 3],
+};
+
+impl Map {
+    /// The Clarke vector's alpha and beta of the mapped set as weights on the logged
+    /// channels (amplitude-invariant Clarke).
+    fn clarke(&self) -> ([f64; 3], [f64; 3]) {
+        const A: [f64; 3] = [2.0 / 3.0, -1.0 / 3.0, -1.0 / 3.0];
+        let b = [0.0, 1.0 / 3f64.sqrt(), -1.0 / 3f64.sqrt()];
+        let (mut wa, mut wb) = ([0.0; 3], [0.0; 3]);
+        for k in 0..3 {
+            wa[self.perm[k]] += A[k] * self.sign[k];
+            wb[self.perm[k]] += b[k] * self.sign[k];
+        }
+        (wa, wb)
+    }
+
+    /// With channels `p.0` and `p.1` exchanged.
+    fn exchanged(mut self, p: (usize, usize)) -> Map {
+        self.perm.swap(p.0, p.1);
+        self.sign.swap(p.0, p.1);
+        self
+    }
+
+    /// Rotated by `by` phases (channel k reads channel k + by).
+    fn rotated(self, by: usize) -> Map {
+        let mut m = self;
+        for k in 0..3 {
+            m.perm[k] = self.perm[(k + by) % 3];
+            m.sign[k] = self.sign[(k + by) % 3];
+        }
+        m
+    }
+}
+
+/// `x^T c y`.
+fn quad(x: &[f64; 3], c: &[[f64; 3]; 3], y: &[f64; 3]) -> f64 {
+    let mut s = 0.0;
+    for k in 0..3 {
+        for j in 0..3 {
+            s += x[k] * c[k][j] * y[j];
+        }
+    }
+    s
+}
+
+/// The mean square of a mapped set's Clarke vector, `mean |X|^2`.
+fn power(c: &[[f64; 3]; 3], m: &Map) -> f64 {
+    let (a, b) = m.clarke();
+    quad(&a, c, &a) + quad(&b, c, &b)
+}
+
+/// The variance of a set's sum with `sign`, over its mean phase variance.
+fn zero_sequence(c: &[[f64; 3]; 3], sign: [f64; 3]) -> f64 {
+    let phase = (c[0][0] + c[1][1] + c[2][2]) / 3.0;
+    quad(&sign, c, &sign) / phase.max(f64::MIN_POSITIVE)
+}
+
+/// The channel of a set whose sign turned makes its sum vanish, with the sum's RMS over a
+/// phase's as logged; see [`ZERO_SEQUENCE_SUSPECT`].
+fn reversed_channel(c: &[[f64; 3]; 3]) -> Option<(usize, f64)> {
+    let z = zero_sequence(c, [1.0; 3]);
+    if z.sqrt() <= ZERO_SEQUENCE_SUSPECT {
+        return None;
+    }
+    (0..3)
+        .map(|k| {
+            let mut s = [1.0; 3];
+            s[k] = -1.0;
+            (k, zero_sequence(c, s))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .filter(|(_, zk)| zk.sqrt() * ZERO_SEQUENCE_FIXED < z.sqrt())
+        .map(|(k, _)| (k, z.sqrt()))
+}
+
+/// The power-factor angle of a motor's quadrant's middle, and how far `(p, q)` lies from
+/// it: `cos(arg S - 45 deg) |S|`, larger the nearer a motor's.
+fn motoring(p: f64, q: f64) -> f64 {
+    (p + q) / std::f64::consts::SQRT_2
+}
+
+/// The three pairs of a set.
+const PAIRS: [(usize, usize); 3] = [(0, 1), (1, 2), (2, 0)];
+
 impl WiringCheck {
+    /// Follows a row's currents `i`, voltages `v` and speed `w` (all its cells good).
+    #[inline(always)]
+    fn accumulate(&mut self, v: Option<[f64; 3]>, i: [f64; 3], w: Option<f64>) {
+        self.i.push(i);
+        if let Some(p) = self.last {
+            self.lag.push(p, i);
+        }
+        self.last = Some(i);
+        if let Some(v) = v {
+            self.v.push(v);
+            self.vi.push(v, i);
+        }
+        if let Some(w) = w {
+            self.w.0 += w;
+            self.w.1 += 1.0;
+        }
+    }
+
     /// Follows a row whose cells are all good.
     pub fn push(&mut self, r: &Row) {
         self.rows += 1;
@@ -117,51 +303,25 @@ impl WiringCheck {
             for (k, (a, b)) in pairs(v).into_iter().enumerate() {
                 self.equal[3 + k] += u64::from(a == b && a != 0.0);
             }
-            let (ci, cv) = (clarke(i), clarke(v));
-            if let Some((pi, pv)) = self.last {
-                let turn_i = pi[0] * ci[1] - pi[1] * ci[0];
-                let turn_v = pv[0] * cv[1] - pv[1] * cv[0];
-                if turn_i != 0.0 && turn_v != 0.0 {
-                    self.turning += 1;
-                    self.opposite += u64::from((turn_i > 0.0) != (turn_v > 0.0));
-                }
-            }
-            self.last = Some((ci, cv));
         }
+        self.accumulate(r.v_abc, i, r.wm_rad_s);
     }
 
     /// Follows a block of rows whose cells are all good, channel by channel (`v`: the
-    /// voltages a, b, c when the rows have them; `i`: the currents, as long): the same
-    /// counts as [`WiringCheck::push`] row by row, in loops the compiler vectorises.
-    pub fn push_block(&mut self, v: Option<[&[f64]; 3]>, i: [&[f64]; 3]) {
+    /// voltages a, b, c when the rows have them; `i`: the currents, as long; `w`: the
+    /// speed, when they have one): the same counts as [`WiringCheck::push`] row by row.
+    pub fn push_block(&mut self, v: Option<[&[f64]; 3]>, i: [&[f64]; 3], w: Option<&[f64]>) {
         let n = i[0].len();
         self.rows += n as u64;
         count_equal(&mut self.equal[..3], i);
-        let Some(v) = v else {
-            return;
-        };
-        count_equal(&mut self.equal[3..], v);
-        let mut start = 0;
-        while start < n {
-            let m = (n - start).min(CHUNK);
-            let (ci, cv) = (
-                clarke_all(i.map(|c| c.get(start..start + m).unwrap_or_default())),
-                clarke_all(v.map(|c| c.get(start..start + m).unwrap_or_default())),
-            );
-            let first = |c: &Clarke| [c[0][0], c[1][0]];
-            if let Some((pi, pv)) = self.last {
-                let turn_i = pi[0] * first(&ci)[1] - pi[1] * first(&ci)[0];
-                let turn_v = pv[0] * first(&cv)[1] - pv[1] * first(&cv)[0];
-                let (t, o) = turn_counts(turn_i, turn_v);
-                self.turning += t;
-                self.opposite += o;
-            }
-            let (t, o) = count_turns(&ci, &cv, m);
-            self.turning += t;
-            self.opposite += o;
-            let last = |c: &Clarke| [c[0][m - 1], c[1][m - 1]];
-            self.last = Some((last(&ci), last(&cv)));
-            start += m;
+        if let Some(v) = v {
+            count_equal(&mut self.equal[3..], v);
+        }
+        let at = |x: &[f64], k: usize| x.get(k).copied().unwrap_or(0.0);
+        for k in 0..n {
+            let row_i = [at(i[0], k), at(i[1], k), at(i[2], k)];
+            let row_v = v.map(|v| [at(v[0], k), at(v[1], k), at(v[2], k)]);
+            self.accumulate(row_v, row_i, w.map(|w| at(w, k)));
         }
     }
 
@@ -170,83 +330,177 @@ impl WiringCheck {
         self.last = None;
     }
 
-    /// What was found, one line each (empty when nothing).
-    pub fn findings(&self) -> Vec<String> {
+    /// The duplicated channels.
+    fn duplicates(&self) -> Vec<WiringFault> {
+        let sets = [PhaseSet::Currents, PhaseSet::Voltages];
         let mut out = Vec::new();
-        if self.rows < MIN_ROWS {
-            return out;
-        }
-        const NAMES: [(&str, &str); 6] = [
-            ("ia_A", "ib_A"),
-            ("ib_A", "ic_A"),
-            ("ic_A", "ia_A"),
-            ("va_V", "vb_V"),
-            ("vb_V", "vc_V"),
-            ("vc_V", "va_V"),
-        ];
-        for (n, (a, b)) in self.equal.iter().zip(NAMES) {
-            let share = *n as f64 / self.rows as f64;
+        for (k, n) in self.equal.iter().enumerate() {
+            let share = *n as f64 / self.rows.max(1) as f64;
+            let c = sets[k / 3].columns();
+            let (a, b) = PAIRS[k % 3];
             if share > DUPLICATE_SHARE {
-                out.push(format!(
-                    "{a} and {b} read the same value on {:.0} % of the rows: one channel duplicates the other (a copied column, or two inputs on one sensor)",
-                    100.0 * share
-                ));
-            }
-        }
-        if self.turning >= MIN_ROWS {
-            let share = self.opposite as f64 / self.turning as f64;
-            if share > SWAPPED_SHARE {
-                out.push(format!(
-                    "the currents' phase order is reversed against the voltages' on {:.0} % of the rows: two current (or two voltage) channels are swapped",
-                    100.0 * share
-                ));
+                out.push(WiringFault::Duplicated {
+                    first: c[a],
+                    second: c[b],
+                    share,
+                });
             }
         }
         out
     }
+
+    /// The current vector's mean turn per row over `mean|I|^2 sin(w dt)` for the
+    /// currents mapped by `m`: +1 for a positive sequence, -1 for a negative one.
+    fn turn(&self, m: &Map, omega_dt: f64) -> f64 {
+        let (a, b) = m.clarke();
+        let l = self.lag.cov();
+        let t = quad(&a, &l, &b) - quad(&b, &l, &a);
+        t / (power(&self.i.cov(), m) * omega_dt.sin()).max(f64::MIN_POSITIVE)
+    }
+
+    /// The complex power `(P, Q)` of the voltages mapped by `mv` against the currents
+    /// mapped by `mi`, and its coherence `|S| / sqrt(mean|V|^2 mean|I|^2)`.
+    fn power_of(&self, mv: &Map, mi: &Map) -> (f64, f64, f64) {
+        let c = self.vi.cov();
+        let ((va, vb), (ia, ib)) = (mv.clarke(), mi.clarke());
+        let p = quad(&va, &c, &ia) + quad(&vb, &c, &ib);
+        let q = quad(&vb, &c, &ia) - quad(&va, &c, &ib);
+        let norm = (power(&self.v.cov(), mv) * power(&self.i.cov(), mi)).sqrt();
+        (p, q, p.hypot(q) / norm.max(f64::MIN_POSITIVE))
+    }
+
+    /// The speed channel's mean [rad/s] where it says which way the shaft turns.
+    fn shaft(&self, ctx: &WiringContext) -> Option<f64> {
+        let n = self.w.1;
+        let mean = self.w.0 / n.max(1.0);
+        (n >= MIN_ROWS as f64 && mean.abs() > SHAFT_MIN * ctx.sync_rad_s).then_some(mean)
+    }
+
+    /// What was found ([`WiringFault`]s, the ones that decide the others' mapping first);
+    /// empty when nothing.
+    pub fn findings(&self, ctx: &WiringContext) -> Vec<WiringFault> {
+        let mut out = self.duplicates();
+        if self.rows < MIN_ROWS || !out.is_empty() {
+            return out;
+        }
+        let (mut mi, mut mv) = (IDENTITY, IDENTITY);
+        if let Some((k, z)) = reversed_channel(&self.i.cov()) {
+            mi.sign[k] = -1.0;
+            out.push(WiringFault::Reversed {
+                channel: PhaseSet::Currents.columns()[k],
+                zero_sequence: z,
+            });
+        }
+        let voltages = self.v.n >= MIN_ROWS as f64;
+        if voltages {
+            if let Some((k, z)) = reversed_channel(&self.v.cov()) {
+                mv.sign[k] = -1.0;
+                out.push(WiringFault::Reversed {
+                    channel: PhaseSet::Voltages.columns()[k],
+                    zero_sequence: z,
+                });
+            }
+        }
+        let Some(omega_dt) = ctx.omega_dt.filter(|w| *w > 0.0 && *w < 3.0) else {
+            return out;
+        };
+        let turn = self.turn(&mi, omega_dt);
+        let d_i = if turn > DIRECTION_MIN {
+            1.0
+        } else if turn < -DIRECTION_MIN {
+            -1.0
+        } else {
+            return out;
+        };
+        let shaft = self.shaft(ctx);
+        if !voltages {
+            if let Some(w) = shaft.filter(|w| w.signum() != d_i) {
+                out.push(WiringFault::CurrentsAgainstShaft { mean_rad_s: w });
+            }
+            return out;
+        }
+        out.extend(self.order(&mv, &mi, d_i, shaft, turn));
+        out
+    }
+
+    /// The pair of `set` exchanged: the one whose exchange gives a motor's power-factor
+    /// angle back (the three pairs' differ by a third of a turn).
+    fn exchanged_pair(
+        &self,
+        mv: &Map,
+        mi: &Map,
+        set: PhaseSet,
+        coherence: f64,
+    ) -> Option<WiringFault> {
+        let (pair, (p, q, _)) = PAIRS
+            .iter()
+            .map(|pr| {
+                let s = match set {
+                    PhaseSet::Currents => self.power_of(mv, &mi.exchanged(*pr)),
+                    PhaseSet::Voltages => self.power_of(&mv.exchanged(*pr), mi),
+                };
+                (*pr, s)
+            })
+            .max_by(|a, b| motoring(a.1 .0, a.1 .1).total_cmp(&motoring(b.1 .0, b.1 .1)))?;
+        let c = set.columns();
+        Some(WiringFault::Exchanged {
+            set,
+            first: c[pair.0],
+            second: c[pair.1],
+            coherence,
+            angle_deg: q.atan2(p).to_degrees(),
+        })
+    }
+
+    /// The phase order of the voltages (mapped by `mv`) against the currents (mapped by
+    /// `mi`, turning `d_i`, `turn`) and the shaft.
+    fn order(
+        &self,
+        mv: &Map,
+        mi: &Map,
+        d_i: f64,
+        shaft: Option<f64>,
+        turn: f64,
+    ) -> Option<WiringFault> {
+        let (p, q, coherence) = self.power_of(mv, mi);
+        let forward = shaft.map_or(1.0, f64::signum);
+        if coherence < COHERENCE_MISMATCH {
+            // One set turns against the other: the one against the shaft (without a speed,
+            // the currents against the voltages) has two channels exchanged.
+            let set = if d_i != forward || shaft.is_none() {
+                PhaseSet::Currents
+            } else {
+                PhaseSet::Voltages
+            };
+            return self.exchanged_pair(mv, mi, set, coherence);
+        }
+        if d_i < 0.0 {
+            return Some(WiringFault::PhaseOrderReversed {
+                shaft_backwards: forward < 0.0,
+                turn,
+            });
+        }
+        if let Some(w) = shaft.filter(|w| *w < 0.0) {
+            return Some(WiringFault::SpeedReversed { mean_rad_s: w });
+        }
+        // Forward: the power-factor angle must be a motor's (or near it).
+        let angle = q.atan2(p).to_degrees();
+        if (-ROTATED_OUTSIDE_DEG..=90.0 + ROTATED_OUTSIDE_DEG).contains(&angle) {
+            return None;
+        }
+        let (by, _) = [1usize, 2]
+            .into_iter()
+            .map(|by| {
+                let (p, q, _) = self.power_of(mv, &mi.rotated(by));
+                (by, motoring(p, q))
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        Some(WiringFault::Rotated {
+            by: by as u8,
+            angle_deg: angle,
+        })
+    }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn row(t: f64, order: [usize; 3], dup: bool) -> Row {
-        let w = std::f64::consts::TAU * 50.0 * t;
-        let ph = |a: f64, lag: f64, k: usize| {
-            a * (w - lag - k as f64 * std::f64::consts::TAU / 3.0).cos()
-        };
-        let mut i = [0, 1, 2].map(|k| ph(10.0, 0.5, order[k]));
-        if dup {
-            i[1] = i[0];
-        }
-        Row {
-            t_s: t,
-            v_abc: Some([0, 1, 2].map(|k| ph(300.0, 0.0, k))),
-            i_abc: i,
-            wm_rad_s: None,
-            enc_count: None,
-            t_winding_c: None,
-        }
-    }
-
-    fn check(order: [usize; 3], dup: bool) -> Vec<String> {
-        let mut c = WiringCheck::default();
-        for k in 0..10_000 {
-            c.push(&row(k as f64 * 1e-4, order, dup));
-        }
-        c.findings()
-    }
-
-    #[test]
-    fn a_clean_set_passes_and_swapped_or_duplicated_channels_are_named() {
-        assert!(check([0, 1, 2], false).is_empty());
-        let swapped = check([0, 2, 1], false);
-        assert_eq!(swapped.len(), 1, "{swapped:?}");
-        assert!(swapped[0].contains("reversed"), "{swapped:?}");
-        let dup = check([0, 1, 2], true);
-        assert!(
-            dup.iter().any(|f| f.starts_with("ia_A and ib_A")),
-            "{dup:?}"
-        );
-    }
-}
+mod tests;

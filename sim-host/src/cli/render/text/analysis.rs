@@ -409,17 +409,9 @@ fn ladder_row(k: usize, s: &monitor_api::analysis::LadderStep) -> String {
     )
 }
 
-/// A multiple of the noise floor as the table prints it (`12.3x`); beyond 999x (a noise-free
-/// log's floor is next to nothing) `>999x`, the ratio saying no more there; `-` where no
-/// error was measured (the model could not run).
+/// A multiple of the noise floor as the table prints it (`super::super::times_floor`).
 fn times(r: f64) -> String {
-    if !r.is_finite() {
-        "-".into()
-    } else if r < 999.5 {
-        format!("{r:.1}x")
-    } else {
-        ">999x".into()
-    }
+    super::super::times_floor(r)
 }
 
 /// A value with four significant digits, in plain or scientific notation by its size.

@@ -254,8 +254,8 @@ fn unbalance(
 ) -> anyhow::Result<()> {
     writeln!(
         out,
-        "unbalance: |I2|/|I1| = {:.2} %, suspect phase: {}",
-        100.0 * u.negative_sequence_ratio,
+        "unbalance: |I2|/|I1| = {}, suspect phase: {}",
+        words::sequence_ratio(u.negative_sequence_ratio),
         words::suspect(u)
     )?;
     if u.segments.len() > 1 {
@@ -297,11 +297,11 @@ fn stretches(out: &mut impl Write, u: &monitor_api::replay::UnbalanceReport) -> 
     for (k, s) in u.segments.iter().enumerate().take(SEGMENTS_LISTED) {
         writeln!(
             out,
-            "    at {:.2}..{:.2} s: |I1| {:.3} A, I2/I1 {:.1} % at {:.0} deg{}",
+            "    at {:.2}..{:.2} s: |I1| {:.3} A, I2/I1 {} at {:.0} deg{}",
             s.from_s,
             s.to_s,
             s.i1_peak_a,
-            100.0 * s.negative_sequence_ratio,
+            words::sequence_ratio(s.negative_sequence_ratio),
             s.angle_deg,
             if u.judged_segment == Some(k) {
                 "  <- judged"

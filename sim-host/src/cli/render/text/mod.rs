@@ -210,15 +210,19 @@ fn panel_text(p: &Panel) -> String {
 /// The data-quality stage's warnings on stderr, one line each.
 pub fn quality_warnings(q: &DataQuality) {
     let mut err = std::io::stderr().lock();
+    let mut line = |l: String| {
+        for part in crate::cli::out::wrap(&l) {
+            let _ = writeln!(err, "{part}");
+        }
+    };
     for w in &q.warnings {
-        let _ = writeln!(err, "warning: {w}");
+        line(format!("warning: {w}"));
     }
     if !q.trusted {
-        let _ = writeln!(
-            err,
+        line(format!(
             "warning: no verdict from this log: {}",
             q.not_trusted_because.join("; ")
-        );
+        ));
     }
 }
 
