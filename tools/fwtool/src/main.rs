@@ -7,9 +7,10 @@
 //!   224 KiB; 32 KiB of static RAM), whether every allocated section lies in bank 1 (bank 2,
 //!   from 0x0804_0000, is the records' and the reset log's) and whether the stack lies below
 //!   the statics (flip-link). `--check` exits 1 when any of these is missed.
-//! - `fw bring-up [--no-flash]`: flash the firmware with probe-rs, reset, and read back over
-//!   the probe every register the boot's self-check reads, each against its expected value
-//!   (`bring_up`; the user installs probe-rs). Exits 1 on a mismatch.
+//! - `fw bring-up [--no-flash] [--dry-run]`: flash the firmware with probe-rs, reset, and
+//!   read back over the probe every register the boot's self-check reads, each against its
+//!   expected value, as a table (`bring_up`; the user installs probe-rs). Exits 1 on a
+//!   mismatch. `--dry-run` prints the commands and what each read should find.
 //! - `qemu-core`: build `crates/core-on-m4` for `thumbv7em-none-eabihf`, check that its
 //!   vector table is at 0x0 (the mps2-an386 layout, not the G474's), and run it on
 //!   `qemu-system-arm -M mps2-an386 -cpu cortex-m4 -icount shift=0` with semihosting.
@@ -279,8 +280,20 @@ fn print_usage(
 }
 
 /// `fw bring-up` (`bring_up`): the firmware built, flashed (unless `--no-flash`) and its
-/// registers read back over the probe.
-fn fw_bring_up(no_flash: bool) -> Result<ExitCode, String> {
+/// registers read back over the probe; with `dry_run` only the commands and what each read
+/// should find, printed (nothing built, no probe).
+fn fw_bring_up(no_flash: bool, dry_run: bool) -> Result<ExitCode, String> {
+    if dry_run {
+        let root = root().canonicalize().unwrap_or_else(|_| root());
+        let elf = target_dir(&root)
+            .join(TARGET)
+            .join("firmware/drive-monitor");
+        println!("cargo build --profile firmware --target {TARGET} -p drive-monitor");
+        for line in bring_up::plan(&elf.to_string_lossy(), no_flash) {
+            println!("{line}");
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
     let elf = build_firmware()?;
     Ok(if bring_up::run(&elf, no_flash)? {
         ExitCode::SUCCESS
@@ -415,13 +428,16 @@ fn main() -> ExitCode {
             bor(args.iter().any(|a| a == "--dry-run")).map(|()| ExitCode::SUCCESS)
         }
         Some("fw") if args.get(1).map(String::as_str) == Some("bring-up") => {
-            fw_bring_up(args.iter().any(|a| a == "--no-flash"))
+            fw_bring_up(
+                args.iter().any(|a| a == "--no-flash"),
+                args.iter().any(|a| a == "--dry-run"),
+            )
         }
         Some("fw") => fw(args.iter().any(|a| a == "--check")).map(|()| ExitCode::SUCCESS),
         Some("qemu-core") => qemu_core(),
         Some("qemu-rtt") => qemu_rtt(&args[1..]),
         _ => Err(
-            "usage: fwtool fw [--check] | fw bor [--dry-run] | fw bring-up [--no-flash] | qemu-core | qemu-rtt [--blocking | --drop-on-contention]"
+            "usage: fwtool fw [--check] | fw bor [--dry-run] | fw bring-up [--no-flash] [--dry-run] | qemu-core | qemu-rtt [--blocking | --drop-on-contention]"
                 .into(),
         ),
     };
