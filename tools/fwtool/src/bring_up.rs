@@ -300,13 +300,19 @@ pub fn read_back(
 /// should.
 pub fn run(elf: &Path, no_flash: bool) -> Result<bool, String> {
     let elf = elf.to_string_lossy().into_owned();
-    let chip = ["--chip".to_string(), CHIP.to_string()];
+    let args = |first: &str, rest: &[&str]| -> Vec<String> {
+        [first, "--chip", CHIP]
+            .iter()
+            .chain(rest)
+            .map(|a| a.to_string())
+            .collect()
+    };
     if !no_flash {
         println!("probe-rs download --chip {CHIP} {elf}");
-        probe_rs(&[&["download".to_string()][..], &chip, &[elf.clone()]].concat())?;
+        probe_rs(&args("download", &[&elf]))?;
     }
     println!("probe-rs reset --chip {CHIP}; {BOOT_WAIT_S} s for the boot");
-    probe_rs(&[&["reset".to_string()][..], &chip].concat())?;
+    probe_rs(&args("reset", &[]))?;
     std::thread::sleep(Duration::from_secs(BOOT_WAIT_S));
     let (lines, all) = read_back(probe_rs)?;
     for l in lines {
