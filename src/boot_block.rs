@@ -9,8 +9,11 @@
 //!   `PreviousRun::hung_in`).
 //! - **Failed boots in a row**: a run that failed (a reset record, or a watchdog reset with
 //!   none: `PreviousRun::failed`) before it was **up** (sampling with the watchdog petted
-//!   for [`UP_AFTER_MS`]) counts one more; a run that was up, or a reset the firmware did not
-//!   cause (power-on, brown-out, the reset button, a debugger's), starts the count again.
+//!   for [`UP_AFTER_MS`]) and was reset by the firmware (`ResetSource::caused_by_firmware`:
+//!   the watchdog, the fault path's software reset) counts one more; a run that was up, or
+//!   a reset the firmware did not cause (power-on, brown-out, the reset button, a debugger's
+//!   reset during a stall's or a set-up's record, `PreviousRun::ResetDuring`), starts the
+//!   count again, whatever record the run left.
 //!   After [`SAFE_MODE_AFTER`] failed boots in a row the boot enters the safe mode
 //!   (`crate::startup`): it blinks its code and records why instead of failing again.
 //! - **Long up**: the run was up for [`LONG_UP_AFTER_MS`]: the next boot writes the reset
@@ -138,7 +141,11 @@ impl BootHistory {
     pub fn of(left: Option<BootBlock>, source: ResetSource, previous: &PreviousRun) -> Self {
         let kind = ResetKind::of(source, left.is_some());
         let before = left.unwrap_or_default();
-        let failed_boots = if previous.failed() && !before.up {
+        // A stall's or a set-up's record with another reset than the watchdog's: someone
+        // (the button, a debugger, the supply) reset the MCU before the firmware would have.
+        let reset_by_someone = matches!(previous, PreviousRun::ResetDuring { .. });
+        let failed = previous.failed() && source.caused_by_firmware() && !reset_by_someone;
+        let failed_boots = if failed && !before.up {
             before.failed_boots.saturating_add(1)
         } else {
             0
@@ -243,10 +250,54 @@ mod tests {
         // The reset button, a power-on, a clean end: not a failure.
         let pin = BootHistory::of(Some(four), ResetSource::Pin, &PreviousRun::Clean);
         assert_eq!((pin.failed_boots, pin.kind), (0, ResetKind::Pin));
-        // A panic's record counts whatever reset followed it.
+        // A panic's record with the fault path's software reset counts (and the watchdog's,
+        // when the software reset did not come)...
         let panic = PreviousRun::Recorded(ResetRecord::panic("x", "f.rs", 1));
         let sw = BootHistory::of(Some(four), ResetSource::Software, &panic);
         assert!(sw.safe_mode() && sw.kind == ResetKind::Software);
+        assert!(BootHistory::of(Some(four), wd, &panic).safe_mode());
+        // ... but the reset button, a brown-out or a power-on after it is a person's or the
+        // supply's: the count starts again.
+        for source in [ResetSource::Pin, ResetSource::PowerOnOrBrownOut] {
+            assert_eq!(BootHistory::of(Some(four), source, &panic).failed_boots, 0);
+        }
+    }
+
+    /// A stalled sample path writes its record and the watchdog ends the run 200 ms later:
+    /// that counts. The reset button pressed (or a debugger's reset) before the watchdog's:
+    /// the count starts again, and the boot still reports the stall (`ResetDuring`).
+    #[test]
+    fn a_button_press_after_a_stall_starts_the_count_again() {
+        let stall = ResetRecord::sample_stall(300).encode();
+        let four = BootBlock {
+            failed_boots: 4,
+            ..BootBlock::default()
+        };
+        let wd = ResetSource::IndependentWatchdog;
+        let by_watchdog = PreviousRun::at_boot(&stall, wd);
+        assert!(BootHistory::of(Some(four), wd, &by_watchdog).safe_mode());
+        for source in [ResetSource::Pin, ResetSource::Software] {
+            let pressed = PreviousRun::at_boot(&stall, source);
+            assert!(
+                matches!(pressed, PreviousRun::ResetDuring { .. }),
+                "{source:?}"
+            );
+            let h = BootHistory::of(Some(four), source, &pressed);
+            assert_eq!((h.failed_boots, h.safe_mode()), (0, false), "{source:?}");
+        }
+        // The firmware's resets and the others', by the flags.
+        for (source, firmware) in [
+            (wd, true),
+            (ResetSource::WindowWatchdog, true),
+            (ResetSource::Software, true),
+            (ResetSource::LowPower, true),
+            (ResetSource::Pin, false),
+            (ResetSource::PowerOnOrBrownOut, false),
+            (ResetSource::OptionBytes, false),
+            (ResetSource::Unknown, false),
+        ] {
+            assert_eq!(source.caused_by_firmware(), firmware, "{source:?}");
+        }
     }
 
     #[test]
