@@ -22,24 +22,34 @@
 //! - **Whether RAM survived**: a valid block after a reset by the power-on/brown-out flag
 //!   (`RCC_CSR.BORRSTF`, which both set) means the supply dipped below the brown-out level
 //!   but not far enough to lose RAM: a brown-out; no valid block, a power-on ([`ResetKind`]).
+//! - **The reset log's counts not yet in flash** ([`Pending`]): a boot counts its reset here
+//!   instead of writing it, until the write is due (`crate::reset_record::log::record_boot`),
+//!   so a supply chattering at the brown-out threshold costs the log one write every
+//!   [`FLUSH_AFTER`](crate::reset_record::log::FLUSH_AFTER) boots, not one a boot.
 //!
-//! # RecordLayout ([`BOOT_BLOCK_LEN`] = 16 bytes, the project's record format, magic `DMBB`)
+//! # RecordLayout ([`BOOT_BLOCK_LEN`] = 32 bytes, the project's record format, magic `DMBB`)
 //!
 //! | bytes | field |
 //! |---|---|
-//! | 0..8 | header: magic `DMBB`, version 1, length 4 ([`monitor_core::record`]) |
+//! | 0..8 | header: magic `DMBB`, version 2, length 20 ([`monitor_core::record`]) |
 //! | 8 | the phase mark ([`BootPhase::number`]; 255: none) |
 //! | 9 | failed boots in a row |
 //! | 10 | flags: bit 0 up, bit 1 long up |
 //! | 11 | reserved, 0 |
-//! | 12..16 | CRC-32 of bytes 0..12 |
+//! | 12..28 | the counts not yet in flash ([`Pending::encode`]) |
+//! | 28..32 | CRC-32 of bytes 0..28 |
+//!
+//! Version 1 (16 bytes, without the counts) is not read: the block lives in RAM across one
+//! reset, and the first boot after an update reads none (a power-on).
 
+pub use crate::reset_record::log::Pending;
+use crate::reset_record::log::PENDING_LEN;
 pub use crate::reset_record::ResetKind;
 use crate::reset_record::{BootPhase, PreviousRun, ResetSource};
 use monitor_core::record::{RecordFormat, RecordLayout, CRC_LEN, HEADER_LEN};
 
 /// Bytes of the block.
-pub const BOOT_BLOCK_LEN: usize = 16;
+pub const BOOT_BLOCK_LEN: usize = 32;
 /// Failed boots in a row after which the boot enters the safe mode.
 pub const SAFE_MODE_AFTER: u8 = 5;
 pub use crate::liveness::{LONG_UP_AFTER_MS, UP_AFTER_MS};
@@ -48,7 +58,7 @@ pub use crate::liveness::{LONG_UP_AFTER_MS, UP_AFTER_MS};
 pub const FORMAT: RecordFormat = RecordFormat {
     magic: *b"DMBB",
     current: RecordLayout {
-        version: 1,
+        version: 2,
         stored_len: BOOT_BLOCK_LEN,
         length: (BOOT_BLOCK_LEN - HEADER_LEN - CRC_LEN) as u16,
     },
@@ -72,6 +82,8 @@ pub struct BootBlock {
     pub up: bool,
     /// The run is long up ([`LONG_UP_AFTER_MS`]).
     pub long_up: bool,
+    /// The reset log's counts not yet in flash.
+    pub pending: Pending,
 }
 
 impl BootBlock {
@@ -85,6 +97,7 @@ impl BootBlock {
             flags,
             0,
         ]);
+        w.bytes(&self.pending.encode());
         w.finish()
     }
 
@@ -92,11 +105,13 @@ impl BootBlock {
     pub fn decode(bytes: &[u8; BOOT_BLOCK_LEN]) -> Option<BootBlock> {
         let mut r = FORMAT.open(bytes).ok()?;
         let [phase, failed_boots, flags, _] = r.take::<4>().ok()?;
+        let pending = Pending::decode(&r.take::<PENDING_LEN>().ok()?);
         Some(BootBlock {
             phase: BootPhase::from_number(phase),
             failed_boots,
             up: flags & FLAG_UP != 0,
             long_up: flags & FLAG_LONG_UP != 0,
+            pending,
         })
     }
 
@@ -132,6 +147,12 @@ pub struct BootHistory {
     pub last_phase: Option<BootPhase>,
     /// The previous run was long up (the reset log's "up" mark is due).
     pub previous_long_up: bool,
+    /// The previous run was up (the counts in RAM are written now).
+    pub previous_up: bool,
+    /// RAM survived the reset (the previous run's block was valid).
+    pub ram_kept: bool,
+    /// The reset log's counts the previous runs left in RAM.
+    pub pending: Pending,
 }
 
 impl BootHistory {
@@ -155,6 +176,9 @@ impl BootHistory {
             failed_boots,
             last_phase: before.phase,
             previous_long_up: before.long_up,
+            previous_up: before.up,
+            ram_kept: left.is_some(),
+            pending: before.pending,
         }
     }
 
@@ -163,13 +187,15 @@ impl BootHistory {
         self.failed_boots >= SAFE_MODE_AFTER
     }
 
-    /// The block this run starts with: its failed boots in a row, not up.
+    /// The block this run starts with: its failed boots in a row, not up, the counts the
+    /// previous runs left.
     pub const fn block(&self) -> BootBlock {
         BootBlock {
             phase: None,
             failed_boots: self.failed_boots,
             up: false,
             long_up: false,
+            pending: self.pending,
         }
     }
 }
@@ -186,13 +212,36 @@ mod tests {
             failed_boots: 3,
             up: false,
             long_up: true,
+            pending: Pending::EMPTY,
         };
         assert_eq!(BootBlock::decode(&b.encode()), Some(b));
         assert_eq!(BootBlock::decode(&[0x5A; BOOT_BLOCK_LEN]), None);
         assert_eq!(BootBlock::decode(&[0; BOOT_BLOCK_LEN]), None);
-        // The header the module docs give: magic, version 1, a payload of 4 bytes.
-        assert_eq!(b.encode()[..8], *b"DMBB\x01\x00\x04\x00");
+        // The header the module docs give: magic, version 2, a payload of 20 bytes.
+        assert_eq!(b.encode()[..8], *b"DMBB\x02\x00\x14\x00");
         assert_eq!(b.encode()[8..12], [BootPhase::Clock.number(), 3, 2, 0]);
+        // The counts in RAM round trip: a brown-out twice, a failed watchdog reset once.
+        let mut pending = Pending::EMPTY;
+        assert!(pending.add(ResetKind::BrownOut, false, false));
+        assert!(pending.add(ResetKind::BrownOut, false, false));
+        assert!(pending.add(ResetKind::Watchdog, true, false));
+        let with = BootBlock { pending, ..b };
+        let bytes = with.encode();
+        assert_eq!(BootBlock::decode(&bytes), Some(with));
+        assert_eq!(
+            bytes[12..20],
+            [
+                ResetKind::BrownOut.index() as u8,
+                0,
+                2,
+                0,
+                0x40 | 3,
+                0,
+                1,
+                0
+            ]
+        );
+        assert_eq!(BootBlock::decode(&bytes).unwrap().pending.count(), 3);
         // Every flag alone round trips.
         for (up, long_up) in [(false, false), (true, false), (false, true), (true, true)] {
             let b = BootBlock {

@@ -5,7 +5,8 @@
 //! the watchdog: a board that stays in the safe mode until a person presses the reset
 //! button or cycles the power, instead of resetting for ever. Nothing is sampled, and no
 //! flash is touched: the reset log's scan, which a boot loop might come from, is not run
-//! (`tests/boot_bookkeeping.rs` holds this file to that).
+//! (`tests/boot_bookkeeping.rs` holds this file to that); the boot is counted in the boot
+//! block's RAM, which the next run writes to the log.
 
 use drive_monitor::app::PANEL_PERIOD_MS;
 use drive_monitor::board::pins::Board;
@@ -13,7 +14,7 @@ use drive_monitor::panel::PanelLamps;
 use drive_monitor::startup::{BootFacts, SafeModeReason};
 use embassy_time::{Duration, Instant, Timer};
 
-use super::{start_watchdog, vcp, PanelPins};
+use super::{reset_ram, start_watchdog, vcp, PanelPins};
 
 /// The safe mode (module docs), for ever.
 pub(super) async fn run(
@@ -24,6 +25,9 @@ pub(super) async fn run(
     let b = Board::take(p);
     let mut wdg = start_watchdog(b.iwdg);
     let mut lamps = PanelPins::new(b.lamps);
+    if !reset_ram::count_safe_mode(facts) {
+        defmt::warn!("reset log: the safe mode's boot not counted (the counts in RAM are full)");
+    }
     vcp::report_safe_mode(b.vcp, facts);
     let start = Instant::now();
     let period = Duration::from_millis(u64::from(PANEL_PERIOD_MS));

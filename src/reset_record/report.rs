@@ -207,6 +207,17 @@ pub fn totals_line(t: &Totals) -> ReportLine {
     l
 }
 
+/// `reset log: N resets counted in RAM, not yet written` when `n` > 0 (the totals above
+/// include them; `log::Pending`).
+pub fn pending_line(n: u32) -> Option<ReportLine> {
+    let mut l = ReportLine::default();
+    l.push("reset log: ")
+        .number(n)
+        .push(" resets counted in RAM, not yet written")
+        .end();
+    (n > 0).then_some(l)
+}
+
 /// `head` and the `items`, comma separated (the self-check's findings: `self-check: did not
 /// take: RCC_CR.CSSON, FLASH_OPTR.BOR_LEV`); `None` without items.
 pub fn list_line<'a>(head: &str, items: impl Iterator<Item = &'a str>) -> Option<ReportLine> {
@@ -276,6 +287,7 @@ pub fn head_lines(version: &str, facts: &BootFacts) -> [Option<ReportLine>; 4] {
 pub fn safe_mode_report(version: &str, facts: &BootFacts) -> [Option<ReportLine>; 5] {
     let [a, b, c, d] = head_lines(version, facts);
     let mut log = ReportLine::default();
-    log.push("reset log: not read in the safe mode").end();
+    log.push("reset log: not read in the safe mode (this boot is counted in RAM, written by the next run)")
+        .end();
     [a, b, c, d, Some(log)]
 }
