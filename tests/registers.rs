@@ -391,15 +391,21 @@ fn the_acquisitions_adc_registers_are_rm0440s() {
                 eos: false,
             },
         );
-        reads(
-            &[(base + ADC_ISR, EOC | EOS)],
-            |r| r.adc_flags(i),
-            AdcFlags {
+        // Each flag alone, and every bit but it.
+        for (flag, eoc) in [(EOC, true), (EOS, false)] {
+            let alone = AdcFlags {
                 ovr: false,
-                eoc: true,
-                eos: true,
-            },
-        );
+                eoc,
+                eos: !eoc,
+            };
+            reads(&[(base + ADC_ISR, flag)], |r| r.adc_flags(i), alone);
+            let others = AdcFlags {
+                ovr: true,
+                eoc: !eoc,
+                eos: eoc,
+            };
+            reads(&[(base + ADC_ISR, !flag)], |r| r.adc_flags(i), others);
+        }
         let all = AdcFlags {
             ovr: true,
             eoc: true,
@@ -621,13 +627,24 @@ fn the_fault_paths_registers_are_rm0440s() {
     };
     // RUN on PA5 (LD2); r1 PB14, r2 PB9, r3 PB10, r4 PB12, FAULT PB13 (the board's table).
     let b_pins = [14, 9, 10, 12, 13];
+    // Ports C..G carry no lamp: their registers are not written.
+    let others: Vec<(u32, u32)> = (2..7u32)
+        .flat_map(|port| {
+            let base = GPIOA + 0x400 * port;
+            [(base + GPIO_MODER, SENTINEL), (base + GPIO_BSRR, SENTINEL)]
+        })
+        .collect();
+    let prepared: Vec<(u32, u32)> = [
+        (GPIOA + GPIO_MODER, moder_a),
+        (GPIOA + GPIO_BSRR, SENTINEL),
+        (GPIOB + GPIO_MODER, moder_b),
+        (GPIOB + GPIO_BSRR, SENTINEL),
+    ]
+    .into_iter()
+    .chain(others)
+    .collect();
     writes(
-        &[
-            (GPIOA + GPIO_MODER, moder_a),
-            (GPIOA + GPIO_BSRR, SENTINEL),
-            (GPIOB + GPIO_MODER, moder_b),
-            (GPIOB + GPIO_BSRR, SENTINEL),
-        ],
+        &prepared,
         |r| r.show_lamps(|l| lit.contains(&l)),
         &[
             (GPIOA + GPIO_MODER, output(moder_a, &[5])),
