@@ -554,3 +554,18 @@ fn the_report_says_what_waits_in_ram() {
 fn log_report_pending(n: u32) -> Option<drive_monitor::reset_record::report::ReportLine> {
     drive_monitor::reset_record::report::pending_line(n)
 }
+
+/// The log's 16 pages sit where memory.x and docs/firmware.md say, 0x0807_6800..0x0807_E800,
+/// and end where the commissioning record's second page begins (`board.rs` derives the
+/// offset from `log::PAGES` and asserts this at compile time).
+#[test]
+fn the_logs_pages_end_where_the_records_begin() {
+    use drive_monitor::board::{RECORD_B_FLASH_OFFSET, RESET_LOG_FLASH_OFFSET};
+    assert_eq!(PAGES, 16);
+    assert_eq!(0x0800_0000 + RESET_LOG_FLASH_OFFSET, 0x0807_6800);
+    assert_eq!(
+        RESET_LOG_FLASH_OFFSET + (PAGES * PAGE_LEN) as u32,
+        RECORD_B_FLASH_OFFSET
+    );
+    assert_eq!(0x0800_0000 + RECORD_B_FLASH_OFFSET, 0x0807_E800);
+}
