@@ -710,7 +710,7 @@ fn the_self_checks_table_reads_where_the_layer_writes() {
         }),
     );
     r.set_css(true);
-    mem.set(FLASH_OPTR, 0xFFEF_F8AA | 4 << 8);
+    mem.set(FLASH_OPTR, (0xFFEF_F8AA | 4 << 8) & !(1 << 26));
     let e = self_check::expectation(drive_monitor::clock::ClockSource::Hse, None);
     let found = self_check::run(&CheckId::BOOT, &e, |a| r.read_word(a));
     assert!(

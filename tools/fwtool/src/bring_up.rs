@@ -114,7 +114,9 @@ pub fn remedy(id: CheckId) -> &'static str {
         CheckId::ClockSecurity => {
             "the crystal did not start (the boot report says so): check X3 and its solder bridges (step 4)"
         }
-        CheckId::BrownOutLevel => "run `cargo fw bor` once for this board (step 6)",
+        CheckId::BrownOutLevel | CheckId::BootPinIgnored => {
+            "run `cargo fw bor` once for this board (step 6: BOR_LEV = 4, nSWBOOT0 = 0)"
+        }
         CheckId::CcmSramKept
         | CheckId::SramParityOff
         | CheckId::BootFromFlash
@@ -333,7 +335,7 @@ mod tests {
             (0xE004_2008, 1 << 12),
             (0xE004_2010, 1 << 11 | 1 << 16),
             (0x4002_1000, 0x0303_0500 | 1 << 19),
-            (0x4002_2020, 0xFFEF_F8AA | 4 << 8),
+            (0x4002_2020, (0xFFEF_F8AA | 4 << 8) & !(1 << 26)),
             (0x4000_0808, 0b0011),
             (0x4000_0818, 0x0101 | 6 << 4 | 6 << 12),
             (0x4000_081C, 0b11),
@@ -406,6 +408,7 @@ mod tests {
             (CheckId::EncoderEnables, 0x4000_0800 + 0x20),
             (CheckId::LatchDma, 0x4000_0800 + 0x0C),
             (CheckId::AdcCommon, 0x5000_0300 + 0x08),
+            (CheckId::BootPinIgnored, 0x4002_2000 + 0x20),
         ];
         assert_eq!(rm0440.len(), CheckId::ALL.len());
         for (id, address) in rm0440 {
@@ -434,13 +437,21 @@ mod tests {
         assert_eq!(lines.len(), 2 + CheckId::ALL.len() + 1);
         assert!(lines.last().unwrap().contains("every register holds"));
 
+        // The factory's option bytes (the brown-out level 0, nSWBOOT0 1) and the crystal
+        // not started.
         let mut wrong = good_board();
         wrong.insert(0x4002_2020, 0xFFEF_F8AA);
         wrong.insert(0x4002_1000, 0x0303_0500);
         let (lines, all) = read_back(|args| answer(&wrong, args)).unwrap();
         assert!(!all);
         let bad: Vec<&String> = lines.iter().filter(|l| l.starts_with("MISMATCH")).collect();
-        assert_eq!(bad.len(), 2, "{lines:#?}");
+        assert_eq!(bad.len(), 3, "{lines:#?}");
+        assert!(
+            bad[2].starts_with("MISMATCH FLASH_OPTR.nSWBOOT0"),
+            "{}",
+            bad[2]
+        );
+        assert!(bad[2].contains("0x04000000   0x00000000"), "{}", bad[2]);
         assert!(bad[0].starts_with("MISMATCH RCC_CR.CSSON"), "{}", bad[0]);
         assert!(bad[0].contains("check X3"), "{}", bad[0]);
         assert!(

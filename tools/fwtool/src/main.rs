@@ -20,8 +20,9 @@
 //!   sample may be lost); `--blocking` builds the control with defmt-rtt's blocking mode (the
 //!   samples must stop), `--drop-on-contention` defmt-rtt's other mode, for comparison.
 //!
-//! - `fw bor [--dry-run]`: program the brown-out reset level 4 (about 2.8 V) into the
-//!   option bytes of the board on the ST-LINK, once per board, with ST's
+//! - `fw bor [--dry-run]`: program the brown-out reset level 4 (about 2.8 V) and the boot
+//!   memory chosen by the option bit, not the BOOT0 pin (`nSWBOOT0` = 0, `nBOOT0` = 1), into
+//!   the option bytes of the board on the ST-LINK, once per board, with ST's
 //!   `STM32_Programmer_CLI` (which runs RM0440's option-byte sequence: unlock, write
 //!   `FLASH_OPTR`, `OPTSTRT`, `OBL_LAUNCH`), then read the option bytes back. The firmware
 //!   only reads the level and warns at every boot while it is below 4; writing option bytes
@@ -308,7 +309,8 @@ const ST_PROGRAMMER: &str = "STM32_Programmer_CLI";
 /// The brown-out level the firmware wants (`drive_monitor::supply::BOR_GOAL`).
 const BOR_LEVEL: u8 = 4;
 
-/// `fw bor`: programs `BOR_LEV` = [`BOR_LEVEL`] over SWD and reads the option bytes back;
+/// `fw bor`: programs `BOR_LEV` = [`BOR_LEVEL`], `nSWBOOT0` = 0 and `nBOOT0` = 1 over SWD
+/// and reads the option bytes back;
 /// with `dry_run` only prints the commands.
 fn bor(dry_run: bool) -> Result<(), String> {
     let program = [
@@ -316,12 +318,17 @@ fn bor(dry_run: bool) -> Result<(), String> {
         "port=SWD".into(),
         "-ob".into(),
         format!("BOR_LEV={BOR_LEVEL}"),
+        // The boot memory from the option bit nBOOT0 (1: the main flash), not from the
+        // BOOT0 pin (PB8): the factory's nSWBOOT0 = 1 lets a pin high at reset start ST's
+        // bootloader (the self-check's `FLASH_OPTR.nSWBOOT0`).
+        "nSWBOOT0=0".into(),
+        "nBOOT0=1".into(),
     ];
     let display = ["-c", "port=SWD", "-ob", "displ"];
     println!("{ST_PROGRAMMER} {}", program.join(" "));
     println!("{ST_PROGRAMMER} {}", display.join(" "));
     if dry_run {
-        println!("(dry run: nothing written; the next boot's log shows `brown-out reset level 4`)");
+        println!("(dry run: nothing written; the next boot's log shows `brown-out reset level 4` and no self-check finding for FLASH_OPTR.nSWBOOT0)");
         return Ok(());
     }
     run(Command::new(ST_PROGRAMMER).args(&program)).map_err(|e| {
