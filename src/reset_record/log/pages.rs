@@ -81,11 +81,23 @@ fn read_until_error<F: LogFlash>(flash: &mut F, page: usize, bytes: &mut [u8; PA
     at
 }
 
-/// The page in use (the valid header with the highest sequence number) and its scan.
+/// The sequence number in page `page`'s header (`None`: the header is not valid, or its
+/// read failed).
+fn header_seq<F: LogFlash>(flash: &mut F, page: usize) -> Option<u32> {
+    let mut header = [0u8; HEADER_LEN];
+    flash.read(page, 0, &mut header).ok()?;
+    Totals::decode_header(&header).map(|(seq, _)| seq)
+}
+
+/// The page in use (the valid header with the highest sequence number) and its scan: every
+/// page's header read, then the one page scanned (a boot reads 16 headers and one page, not
+/// the 16 pages).
 fn locate<F: LogFlash>(flash: &mut F) -> Option<(usize, PageScan)> {
-    (0..PAGES)
-        .filter_map(|page| scan(flash, page, |_| {}).map(|s| (page, s)))
-        .max_by_key(|(_, s)| s.seq)
+    let page = (0..PAGES)
+        .filter_map(|page| header_seq(flash, page).map(|seq| (page, seq)))
+        .max_by_key(|(_, seq)| *seq)?
+        .0;
+    scan(flash, page, |_| {}).map(|s| (page, s))
 }
 
 /// Appends `item` to the log whose page in use is `at` ([`locate`]): after its last item,
