@@ -287,5 +287,10 @@ mod tests {
         assert_eq!(nmi_action(0x8000_1000), NmiAction::Fault);
         assert_eq!(nmi_action(eccr | ECCR_SYSF_ECC), NmiAction::Fault);
         assert_eq!(nmi_action(eccr & !ECCR_ECCD), NmiAction::Fault);
+        // The same address in bank 1 (BK_ECC clear) is code, at offset 0x3_F010: a fault,
+        // never taken for a record page's error (the handler would return into bad code).
+        let bank1 = eccr & !ECCR_BK_ECC;
+        assert_eq!(double_error(bank1), Some(EccError { offset: 0x3_F010 }));
+        assert_eq!(nmi_action(bank1), NmiAction::Fault);
     }
 }
