@@ -345,4 +345,34 @@ mod tests {
         // Outside the record pages nothing is marked.
         assert!(!flash.is_bad(0x100));
     }
+
+    /// The reset log's reads (`read_unmarked`): a double error fails the read and marks
+    /// nothing (the log reads the page again a double word at a time, in the same boot); a
+    /// stale latch from an earlier read is no error of this one.
+    #[test]
+    fn the_logs_reads_report_a_double_error_and_mark_nothing() {
+        let latch = EccLatch::new();
+        let torn = RESET_LOG_FLASH_OFFSET + 0x48;
+        let mut flash = CheckedFlash::new(Torn {
+            latch: &latch,
+            torn,
+        });
+        let mut page = [0u8; 2048];
+        assert_eq!(
+            flash.read_unmarked(&latch, RESET_LOG_FLASH_OFFSET, &mut page),
+            Err(ReadError::Ecc(EccError { offset: torn }))
+        );
+        assert!(!flash.is_bad(RESET_LOG_FLASH_OFFSET));
+        let mut dw = [0u8; 8];
+        assert_eq!(
+            flash.read_unmarked(&latch, RESET_LOG_FLASH_OFFSET, &mut dw),
+            Ok(())
+        );
+        assert_eq!(dw, [0xA5; 8]);
+        latch.latch(EccError { offset: 0 });
+        assert_eq!(
+            flash.read_unmarked(&latch, RESET_LOG_FLASH_OFFSET, &mut dw),
+            Ok(())
+        );
+    }
 }
