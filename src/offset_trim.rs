@@ -473,4 +473,50 @@ mod tests {
         assert_eq!(at_500(560), ChannelTrim::Trimmed(560.0));
         assert_eq!(at_500(2048), ChannelTrim::OutOfBound(2048.0));
     }
+
+    /// The bounds exactly: a spread of exactly `QUIET_SPREAD_CODES` is quiet, a zero exactly
+    /// `MAX_OFFSET_CODES` away is trimmed; a voltage channel out of bound is flagged as a
+    /// voltage fault, not a current one.
+    #[test]
+    fn the_bounds_hold_exactly_and_a_voltage_out_of_bound_is_a_voltage_fault() {
+        // Codes alternating 2040 and 2056: mean 2048, spread exactly 8.
+        let n = 1_000u32;
+        let (lo, hi) = (2040u64, 2056u64);
+        let sum = (n / 2) as u32 * (2040 + 2056);
+        let sum_sq = u64::from(n / 2) * (lo * lo + hi * hi);
+        assert_eq!(
+            judge(sum, sum_sq, n, zeros(2048.0), TrimKind::StartUp),
+            ChannelTrim::Trimmed(2048.0)
+        );
+        // A zero exactly 100 codes from the one in force.
+        let at = |code: u64| (code as u32 * n, code * code * u64::from(n));
+        let (s100, q100) = at(2148);
+        assert_eq!(
+            judge(s100, q100, n, zeros(2048.0), TrimKind::StartUp),
+            ChannelTrim::Trimmed(2148.0)
+        );
+        // Voltage a at the rail at start-up: a voltage fault.
+        let mut trim = OffsetTrim::new(&FrontEnd::DEFAULT);
+        let mut got = None;
+        for _ in 0..TRIM_SAMPLES {
+            got = got.or(trim.add(&frame([4095, 2048, 2048], [2048; 3])));
+        }
+        let r = got.unwrap();
+        assert!(r.voltage_fault() && !r.current_fault(), "{r:?}");
+    }
+
+    /// One count of jitter at an encoder edge is a standing shaft: the window goes on and
+    /// the zeros are re-trimmed.
+    #[test]
+    fn one_count_of_jitter_is_a_standing_shaft() {
+        let mut trim = OffsetTrim::new(&FrontEnd::DEFAULT);
+        for _ in 0..TRIM_SAMPLES {
+            trim.add(&frame_at([2048; 3], [2048; 3], 100));
+        }
+        let mut got = None;
+        for k in 0..TRIM_SAMPLES {
+            got = got.or(trim.add(&frame_at([2050; 3], [2050; 3], 100 + (k % 2) as u16)));
+        }
+        assert_eq!(got.map(|r| r.kind), Some(TrimKind::Retrim));
+    }
 }

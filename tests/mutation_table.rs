@@ -48,5 +48,8 @@ fn every_line_the_mutation_table_cites_is_an_assertion() {
         }
     }
     assert!(cited >= 40, "{cited} lines cited");
-    assert!(wrong.is_empty(), "cited lines that are no assertion: {wrong:#?}");
+    assert!(
+        wrong.is_empty(),
+        "cited lines that are no assertion: {wrong:#?}"
+    );
 }
