@@ -482,7 +482,7 @@ mod tests {
         // Codes alternating 2040 and 2056: mean 2048, spread exactly 8.
         let n = 1_000u32;
         let (lo, hi) = (2040u64, 2056u64);
-        let sum = (n / 2) as u32 * (2040 + 2056);
+        let sum = n / 2 * (2040 + 2056);
         let sum_sq = u64::from(n / 2) * (lo * lo + hi * hi);
         assert_eq!(
             judge(sum, sum_sq, n, zeros(2048.0), TrimKind::StartUp),
