@@ -369,4 +369,39 @@ mod tests {
             assert_eq!(kind.index(), k);
         }
     }
+
+    /// Four kinds of counts in the four slots round trip through the block; a full slot
+    /// (65 535 counts, the writes refused all along) takes no more: nothing wraps.
+    #[test]
+    fn the_counts_in_ram_fill_four_slots_and_never_wrap() {
+        let mut pending = Pending::EMPTY;
+        for (k, kind) in [
+            ResetKind::BrownOut,
+            ResetKind::Pin,
+            ResetKind::Software,
+            ResetKind::Watchdog,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            for _ in 0..=k {
+                assert!(pending.add(kind, kind == ResetKind::Watchdog, false));
+            }
+        }
+        assert!(!pending.add(ResetKind::Other, false, false), "a fifth kind");
+        let block = BootBlock {
+            pending,
+            ..BootBlock::default()
+        };
+        let back = BootBlock::decode(&block.encode()).unwrap();
+        assert_eq!(back.pending, pending);
+        assert_eq!(back.pending.count(), 1 + 2 + 3 + 4);
+        // A slot at 65 535: full.
+        let mut bytes = [0u8; crate::reset_record::log::PENDING_LEN];
+        bytes[..4].copy_from_slice(&[ResetKind::BrownOut.index() as u8, 0, 0xFF, 0xFF]);
+        let mut full = Pending::decode(&bytes);
+        assert_eq!(full.count(), 65_535);
+        assert!(!full.add(ResetKind::BrownOut, false, false));
+        assert_eq!(full.count(), 65_535);
+    }
 }

@@ -608,3 +608,27 @@ fn every_entry_round_trips_with_its_source_and_its_end() {
     bytes.dedup();
     assert_eq!(bytes.len(), 24);
 }
+
+/// A count mark naming no count the log keeps (what = 7, beyond the six kinds and the "up"
+/// marks), its check word valid: read as no mark, its flags not counted.
+#[test]
+fn a_mark_of_no_known_count_is_no_mark() {
+    let mut flash = Pages::erased();
+    record(&mut flash, &clean(ResetKind::PowerOn)).unwrap();
+    let head = [b'C', 7 | 0x40, 1, 0];
+    let check = (!u32::from_le_bytes(head)).to_le_bytes();
+    flash.pages[0][72..76].copy_from_slice(&head);
+    flash.pages[0][76..80].copy_from_slice(&check);
+    let t = log::totals(&mut flash);
+    assert_eq!((t.resets(ResetKind::PowerOn), t.failed_not_entered), (1, 0));
+    // The same mark naming the watchdog (3) is one.
+    let head = [b'C', 3 | 0x40, 1, 0];
+    let check = (!u32::from_le_bytes(head)).to_le_bytes();
+    flash.pages[0][80..84].copy_from_slice(&head);
+    flash.pages[0][84..88].copy_from_slice(&check);
+    let t = log::totals(&mut flash);
+    assert_eq!(
+        (t.resets(ResetKind::Watchdog), t.failed_not_entered),
+        (1, 1)
+    );
+}
