@@ -144,13 +144,27 @@ pub const MOTOR_RECORD_FLASH_OFFSET: u32 = RECORD_FLASH_OFFSET - RECORD_PAGE_SIZ
 /// two copies in turn), bytes: the page before the motor record's, `0x0807_E800`.
 pub const RECORD_B_FLASH_OFFSET: u32 = MOTOR_RECORD_FLASH_OFFSET - RECORD_PAGE_SIZE;
 /// Offset of the reset log (`reset_record::log`: the counts and the last ends of a run,
-/// `reset_record::log::PAGES` pages of 2 KiB) from the start of flash, bytes: the 16 pages
-/// before the record's second, `0x0807_6800`..`0x0807_E800`, bank 2 like the records.
-pub const RESET_LOG_FLASH_OFFSET: u32 = RECORD_B_FLASH_OFFSET - 16 * RECORD_PAGE_SIZE;
+/// [`LOG_PAGES`] pages of 2 KiB) from the start of flash, bytes: the pages before the
+/// record's second, `0x0807_6800`..`0x0807_E800` for 16, bank 2 like the records.
+pub const RESET_LOG_FLASH_OFFSET: u32 = RECORD_B_FLASH_OFFSET - LOG_PAGES * RECORD_PAGE_SIZE;
+/// The reset log's pages (`reset_record::log::PAGES`, the one number both use).
+const LOG_PAGES: u32 = crate::reset_record::log::PAGES as u32;
 /// The start of bank 2 (dual-bank mode) from the start of flash, bytes: `0x0804_0000`.
 /// Everything from here on is data (the records, the reset log), never code.
 pub const BANK2_OFFSET: u32 = 0x0004_0000;
-const _: () = assert!(RESET_LOG_FLASH_OFFSET >= BANK2_OFFSET);
+// The reset log's pages end where the records begin (the commissioning record's second
+// page, then the motor record's, then the first), each page the records' size, all in bank 2:
+// raising `reset_record::log::PAGES` moves the log down, never over a record.
+const _: () = assert!(
+    RESET_LOG_FLASH_OFFSET
+        + crate::reset_record::log::PAGES as u32 * crate::reset_record::log::PAGE_LEN as u32
+        == RECORD_B_FLASH_OFFSET
+        && crate::reset_record::log::PAGE_LEN as u32 == RECORD_PAGE_SIZE
+        && RECORD_B_FLASH_OFFSET + RECORD_PAGE_SIZE == MOTOR_RECORD_FLASH_OFFSET
+        && MOTOR_RECORD_FLASH_OFFSET + RECORD_PAGE_SIZE == RECORD_FLASH_OFFSET
+        && RESET_LOG_FLASH_OFFSET >= BANK2_OFFSET,
+    "the reset log's pages must end where the records begin, in bank 2"
+);
 
 /// A GPIO port of the STM32G474 (`A` = GPIOA, ...).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -121,7 +121,30 @@ pub const fn pll_cfgr(source: ClockSource) -> u32 {
         ClockSource::Hse => 3,
         ClockSource::Hsi | ClockSource::HsiAfterFailure => 2,
     };
-    src | ((source.prediv() - 1) << 4) | (PLL_MUL << 8) | (1 << 24) | ((PLL_RDIV / 2 - 1) << 25)
+    let f = pll_fields(source);
+    src | ((f.m as u32) << 4) | ((f.n as u32) << 8) | (1 << 24) | ((f.r as u32) << 25)
+}
+
+/// The PLL's dividers and multiplier as `RCC_PLLCFGR`'s fields encode them (RM0440):
+/// what embassy-stm32's `rcc::Pll` is given (`PllPreDiv`, `PllMul`, `PllRDiv` from these
+/// bits, `src/firmware/startup_hw.rs`) and what [`pll_cfgr`] writes for the bounded lock.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PllFields {
+    /// `PLLM`: the input divider less one (0..=15: /1../16).
+    pub m: u8,
+    /// `PLLN`: the multiplier (8..=127).
+    pub n: u8,
+    /// `PLLR`: the R output's divider, `R / 2 - 1` (0: /2, 1: /4, 2: /6, 3: /8).
+    pub r: u8,
+}
+
+/// The PLL's fields from `source` ([`PllFields`]).
+pub const fn pll_fields(source: ClockSource) -> PllFields {
+    PllFields {
+        m: (source.prediv() - 1) as u8,
+        n: PLL_MUL as u8,
+        r: (PLL_RDIV / 2 - 1) as u8,
+    }
 }
 
 /// The PLL's multiplier `PLLN` (8..=127).
@@ -242,5 +265,9 @@ mod tests {
             pll_cfgr(ClockSource::HsiAfterFailure),
             pll_cfgr(ClockSource::Hsi)
         );
+        // The fields embassy is handed: M - 1, N, R / 2 - 1 (RM0440's encodings).
+        let hse = PllFields { m: 5, n: 85, r: 0 };
+        assert_eq!(pll_fields(ClockSource::Hse), hse);
+        assert_eq!(pll_fields(ClockSource::Hsi), PllFields { m: 3, ..hse });
     }
 }

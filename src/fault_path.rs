@@ -37,11 +37,6 @@ impl FaultGuard {
     pub fn take(&self) -> bool {
         !self.0.swap(true, Ordering::SeqCst)
     }
-
-    /// Whether a fault is being handled.
-    pub fn is_taken(&self) -> bool {
-        self.0.load(Ordering::SeqCst)
-    }
 }
 
 impl Default for FaultGuard {

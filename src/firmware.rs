@@ -58,7 +58,7 @@ use embassy_stm32::gpio::{Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Async;
 use embassy_stm32::wdg::IndependentWatchdog;
-use embassy_stm32::{bind_interrupts, dma, interrupt, pac, peripherals, Peri};
+use embassy_stm32::{bind_interrupts, dma, interrupt, peripherals, Peri};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
@@ -287,7 +287,7 @@ fn core_peripherals() -> cortex_m::Peripherals {
 /// saying so in the log.
 fn dual_bank_flash() -> bool {
     mark_phase(BootPhase::Flash);
-    let dual_bank = pac::FLASH.optr().read().dbank();
+    let dual_bank = drive_monitor::regs::MCU.dual_bank();
     if !dual_bank {
         error!("option bytes: single-bank flash (DBANK = 0); the records need dual-bank: set DBANK with STM32CubeProgrammer. Running with the built-in motor, not commissioned");
     }

@@ -287,5 +287,92 @@ mod tests {
         assert_eq!(nmi_action(0x8000_1000), NmiAction::Fault);
         assert_eq!(nmi_action(eccr | ECCR_SYSF_ECC), NmiAction::Fault);
         assert_eq!(nmi_action(eccr & !ECCR_ECCD), NmiAction::Fault);
+        // The same address in bank 1 (BK_ECC clear) is code, at offset 0x3_F010: a fault,
+        // never taken for a record page's error (the handler would return into bad code).
+        let bank1 = eccr & !ECCR_BK_ECC;
+        assert_eq!(double_error(bank1), Some(EccError { offset: 0x3_F010 }));
+        assert_eq!(nmi_action(bank1), NmiAction::Fault);
+    }
+
+    /// A flash whose reads of one double word raise the NMI's latch, as a torn write does.
+    struct Torn<'a> {
+        latch: &'a EccLatch,
+        torn: u32,
+    }
+
+    impl RawFlash for Torn<'_> {
+        type Error = ();
+        fn read_raw(&mut self, offset: u32, buf: &mut [u8]) -> Result<(), ()> {
+            if (offset..offset + buf.len() as u32).contains(&self.torn) {
+                self.latch.latch(EccError { offset: self.torn });
+            }
+            buf.fill(0xA5);
+            Ok(())
+        }
+    }
+
+    /// A double error in the motor record's page marks that page bad, not the records'
+    /// pages beside it nor the reset log's; an erase clears the mark.
+    #[test]
+    fn a_double_error_marks_its_own_page_alone() {
+        use crate::board::{MOTOR_RECORD_FLASH_OFFSET, RECORD_B_FLASH_OFFSET};
+        let latch = EccLatch::new();
+        let torn = MOTOR_RECORD_FLASH_OFFSET + 0x40;
+        let mut flash = CheckedFlash::new(Torn {
+            latch: &latch,
+            torn,
+        });
+        let mut buf = [0u8; 8];
+        assert_eq!(
+            flash.read(&latch, MOTOR_RECORD_FLASH_OFFSET, &mut [0u8; 132]),
+            Err(ReadError::Ecc(EccError { offset: torn }))
+        );
+        assert!(flash.is_bad(MOTOR_RECORD_FLASH_OFFSET));
+        assert_eq!(
+            flash.read(&latch, MOTOR_RECORD_FLASH_OFFSET, &mut buf),
+            Err(ReadError::MarkedBad)
+        );
+        for other in [
+            RECORD_FLASH_OFFSET,
+            RECORD_B_FLASH_OFFSET,
+            RESET_LOG_FLASH_OFFSET,
+        ] {
+            assert!(!flash.is_bad(other), "{other:#x}");
+            assert_eq!(flash.read(&latch, other, &mut buf), Ok(()), "{other:#x}");
+        }
+        flash.erased(MOTOR_RECORD_FLASH_OFFSET);
+        assert!(!flash.is_bad(MOTOR_RECORD_FLASH_OFFSET));
+        // Outside the record pages nothing is marked.
+        assert!(!flash.is_bad(0x100));
+    }
+
+    /// The reset log's reads (`read_unmarked`): a double error fails the read and marks
+    /// nothing (the log reads the page again a double word at a time, in the same boot); a
+    /// stale latch from an earlier read is no error of this one.
+    #[test]
+    fn the_logs_reads_report_a_double_error_and_mark_nothing() {
+        let latch = EccLatch::new();
+        let torn = RESET_LOG_FLASH_OFFSET + 0x48;
+        let mut flash = CheckedFlash::new(Torn {
+            latch: &latch,
+            torn,
+        });
+        let mut page = [0u8; 2048];
+        assert_eq!(
+            flash.read_unmarked(&latch, RESET_LOG_FLASH_OFFSET, &mut page),
+            Err(ReadError::Ecc(EccError { offset: torn }))
+        );
+        assert!(!flash.is_bad(RESET_LOG_FLASH_OFFSET));
+        let mut dw = [0u8; 8];
+        assert_eq!(
+            flash.read_unmarked(&latch, RESET_LOG_FLASH_OFFSET, &mut dw),
+            Ok(())
+        );
+        assert_eq!(dw, [0xA5; 8]);
+        latch.latch(EccError { offset: 0 });
+        assert_eq!(
+            flash.read_unmarked(&latch, RESET_LOG_FLASH_OFFSET, &mut dw),
+            Ok(())
+        );
     }
 }

@@ -46,6 +46,9 @@
 //!   (the phase mark, the failed boots in a row that lead to the safe mode);
 //! - [`self_check`]: the boot's read-back of what the firmware wrote (the freeze, the clock
 //!   security system, the option bytes, the encoder's timer, the ADCs' common register);
+//! - [`regs`]: the register layer, every register the firmware touches beside the HAL's
+//!   drivers, one method an access on stm32-metapac's blocks behind a bus the host tests
+//!   point at memory of their own;
 //! - [`startup`]: the start of every run on the registers (freeze, watchdog, the previous
 //!   run, the stack, the clock with its bounded waits, the safe mode, the self-check), over
 //!   a trait the host tests drive with a register model;
@@ -94,6 +97,7 @@ pub mod offset_trim;
 pub mod panel;
 pub mod range_watch;
 pub mod recovery;
+pub mod regs;
 pub mod reset_record;
 pub mod ring_read;
 pub mod sampling;

@@ -30,6 +30,15 @@
 //! start-up trim flags a sensor). The zeros follow a slow drift in steps of at most
 //! [`RETRIM_STEP_CODES`].
 //!
+//! **Bounded against the factory zero.** Judged against the zero in force alone, a current
+//! that creeps up by less than a step a window (a drive's DC hold ramped slowly at
+//! standstill) would drag the zero along, 20 codes every 0.1 s, without end. So a re-trim is
+//! also judged against the **factory zero**, the motor record's (mid-scale for the built-in
+//! default), which no trim moves: a zero farther than [`MAX_OFFSET_CODES`] from it (where the
+//! start-up trim would call the sensor faulty) is [`ChannelTrim::TooFar`], and a zero within
+//! [`RETRIM_STEP_CODES`] of it is taken whatever the zero in force (so a zero a creeping
+//! current dragged comes back in one window once the current is gone).
+//!
 //! Bounded work: six additions, six multiply-adds and a count's comparison per sample.
 
 use crate::board::{FrontEnd, MID_SCALE_CODE};
@@ -130,6 +139,8 @@ pub struct OffsetTrim {
     first_count: Option<u16>,
     /// The zeros in force, codes: va, vb, vc, ia, ib, ic (the record's, then the trims').
     nominal: [f32; 6],
+    /// The factory zeros, codes: the record's, which no trim moves (module docs).
+    factory: [f32; 6],
 }
 
 impl OffsetTrim {
@@ -137,13 +148,15 @@ impl OffsetTrim {
     pub fn new(front_end: &FrontEnd) -> Self {
         let [va, vb, vc] = front_end.voltage;
         let [ia, ib, ic] = front_end.current;
+        let zeros = [va, vb, vc, ia, ib, ic].map(|c| c.offset_code);
         Self {
             sum: [0; 6],
             sum_sq: [0; 6],
             n: 0,
             started: false,
             first_count: None,
-            nominal: [va, vb, vc, ia, ib, ic].map(|c| c.offset_code),
+            nominal: zeros,
+            factory: zeros,
         }
     }
 
@@ -184,12 +197,15 @@ impl OffsetTrim {
             TrimKind::StartUp
         };
         let ch = |k: usize| {
-            let (s, q, zero) = (
+            let (s, q) = (
                 self.sum.get(k).copied().unwrap_or(0),
                 self.sum_sq.get(k).copied().unwrap_or(0),
-                self.nominal.get(k).copied().unwrap_or(MID_SCALE_CODE),
             );
-            judge(s, q, self.n, zero, kind)
+            let zeros = Zeros {
+                in_force: self.nominal.get(k).copied().unwrap_or(MID_SCALE_CODE),
+                factory: self.factory.get(k).copied().unwrap_or(MID_SCALE_CODE),
+            };
+            judge(s, q, self.n, zeros, kind)
         };
         let result = TrimResult {
             kind,
@@ -213,21 +229,35 @@ impl OffsetTrim {
     }
 }
 
+/// A channel's zeros, codes: the one in force and the factory's (module docs).
+#[derive(Clone, Copy, Debug)]
+struct Zeros {
+    in_force: f32,
+    factory: f32,
+}
+
 /// One channel from its sum, sum of squares and count (`n > 0`): mean and spread in codes,
-/// then the bounds around `zero`, the zero in force: [`MAX_OFFSET_CODES`] at start-up,
-/// [`RETRIM_STEP_CODES`] for a re-trim.
-fn judge(sum: u32, sum_sq: u64, n: u32, zero: f32, kind: TrimKind) -> ChannelTrim {
+/// then the bounds: at start-up [`MAX_OFFSET_CODES`] around the zero in force (the
+/// record's); for a re-trim [`RETRIM_STEP_CODES`] around the zero in force or around the
+/// factory zero, and never beyond [`MAX_OFFSET_CODES`] from the factory zero.
+fn judge(sum: u32, sum_sq: u64, n: u32, zeros: Zeros, kind: TrimKind) -> ChannelTrim {
     let n64 = u64::from(n.max(1));
     let s = u64::from(sum);
     // n^2 var = n sum_sq - sum^2, exact in integers (>= 0 for any real data).
     let n2_var = n64.saturating_mul(sum_sq).saturating_sub(s * s);
     let spread = monitor_core::math::sqrt(n2_var as f32) / n64 as f32;
     let mean = sum as f32 / n64 as f32;
-    let distance = (mean - zero).abs();
+    let distance = (mean - zeros.in_force).abs();
+    let from_factory = (mean - zeros.factory).abs();
     if spread > QUIET_SPREAD_CODES {
         ChannelTrim::NotQuiet(spread)
-    } else if kind == TrimKind::Retrim && distance > RETRIM_STEP_CODES {
-        ChannelTrim::TooFar(mean)
+    } else if kind == TrimKind::Retrim {
+        let step = distance <= RETRIM_STEP_CODES || from_factory <= RETRIM_STEP_CODES;
+        if step && from_factory <= MAX_OFFSET_CODES {
+            ChannelTrim::Trimmed(mean)
+        } else {
+            ChannelTrim::TooFar(mean)
+        }
     } else if distance > MAX_OFFSET_CODES {
         ChannelTrim::OutOfBound(mean)
     } else {
@@ -252,6 +282,76 @@ mod tests {
             clipped: crate::sampling::Clipped::NONE,
             encoder_rejects: 0,
         }
+    }
+
+    /// Both zeros at `x`.
+    fn zeros(x: f32) -> Zeros {
+        Zeros {
+            in_force: x,
+            factory: x,
+        }
+    }
+
+    /// A drive's DC hold ramped slowly at standstill: `ia` up and `ib` down by 5 codes a
+    /// window (each window within a step of the zero the last one put into force), to 400
+    /// codes (2 A with the default front end). Judged against the zero in force alone the
+    /// current zeros followed it all the way; bounded against the factory zero they stop
+    /// within `MAX_OFFSET_CODES` of it (the re-trim is then dropped: the currents are not
+    /// zero), the voltages' zeros stay, and once the current is gone the zeros come back to
+    /// the factory zero in one window.
+    #[test]
+    fn a_slow_dc_current_at_standstill_cannot_drag_the_zeros() {
+        let mut trim = OffsetTrim::new(&FrontEnd::DEFAULT);
+        let factory = MID_SCALE_CODE;
+        let window = |trim: &mut OffsetTrim, i: [u16; 3]| {
+            let mut got = None;
+            for _ in 0..TRIM_SAMPLES {
+                got = got.or(trim.add(&frame_at([2048; 3], i, 500)));
+            }
+            got
+        };
+        assert_eq!(
+            window(&mut trim, [2048; 3]).map(|r| r.kind),
+            Some(TrimKind::StartUp)
+        );
+        let mut farthest = 0.0f32;
+        let mut retrims = 0;
+        for w in 1..=80u16 {
+            let dc = 5 * w;
+            if let Some(r) = window(&mut trim, [2048 + dc, 2048 - dc, 2048]) {
+                retrims += 1;
+                for c in r.current {
+                    if let Some(x) = c.offset() {
+                        farthest = farthest.max((x - factory).abs());
+                    }
+                }
+            }
+        }
+        let in_force = |t: &OffsetTrim| t.nominal.map(|z| (z - factory).abs());
+        assert!(farthest <= MAX_OFFSET_CODES, "{farthest}");
+        assert!(
+            in_force(&trim).iter().all(|d| *d <= MAX_OFFSET_CODES),
+            "{:?}",
+            trim.nominal
+        );
+        // It followed while within the bound (a slow drift is still followed) ...
+        assert!(
+            retrims >= 19 && farthest >= MAX_OFFSET_CODES - 5.0,
+            "{retrims} {farthest}"
+        );
+        // ... and comes back once the current is gone.
+        let back = window(&mut trim, [2048; 3]).expect("a re-trim at the factory zero");
+        assert!(
+            back.current
+                .iter()
+                .all(|c| *c == ChannelTrim::Trimmed(2048.0)),
+            "{back:?}"
+        );
+        assert!(
+            in_force(&trim).iter().all(|d| *d <= 0.5),
+            "{:?}",
+            trim.nominal
+        );
     }
 
     #[test]
@@ -339,7 +439,7 @@ mod tests {
     fn the_bounds_are_inclusive_and_a_rail_is_out_of_bound() {
         let half = MID_SCALE_CODE;
         assert!(matches!(
-            judge(0, 0, 10, half, TrimKind::StartUp),
+            judge(0, 0, 10, zeros(half), TrimKind::StartUp),
             ChannelTrim::OutOfBound(_)
         ));
         let at = |code: u32| {
@@ -347,7 +447,7 @@ mod tests {
                 code * 10,
                 u64::from(code * code) * 10,
                 10,
-                half,
+                zeros(half),
                 TrimKind::StartUp,
             )
         };
@@ -366,11 +466,57 @@ mod tests {
                 code * 10,
                 u64::from(code * code) * 10,
                 10,
-                500.0,
+                zeros(500.0),
                 TrimKind::StartUp,
             )
         };
         assert_eq!(at_500(560), ChannelTrim::Trimmed(560.0));
         assert_eq!(at_500(2048), ChannelTrim::OutOfBound(2048.0));
+    }
+
+    /// The bounds exactly: a spread of exactly `QUIET_SPREAD_CODES` is quiet, a zero exactly
+    /// `MAX_OFFSET_CODES` away is trimmed; a voltage channel out of bound is flagged as a
+    /// voltage fault, not a current one.
+    #[test]
+    fn the_bounds_hold_exactly_and_a_voltage_out_of_bound_is_a_voltage_fault() {
+        // Codes alternating 2040 and 2056: mean 2048, spread exactly 8.
+        let n = 1_000u32;
+        let (lo, hi) = (2040u64, 2056u64);
+        let sum = n / 2 * (2040 + 2056);
+        let sum_sq = u64::from(n / 2) * (lo * lo + hi * hi);
+        assert_eq!(
+            judge(sum, sum_sq, n, zeros(2048.0), TrimKind::StartUp),
+            ChannelTrim::Trimmed(2048.0)
+        );
+        // A zero exactly 100 codes from the one in force.
+        let at = |code: u64| (code as u32 * n, code * code * u64::from(n));
+        let (s100, q100) = at(2148);
+        assert_eq!(
+            judge(s100, q100, n, zeros(2048.0), TrimKind::StartUp),
+            ChannelTrim::Trimmed(2148.0)
+        );
+        // Voltage a at the rail at start-up: a voltage fault.
+        let mut trim = OffsetTrim::new(&FrontEnd::DEFAULT);
+        let mut got = None;
+        for _ in 0..TRIM_SAMPLES {
+            got = got.or(trim.add(&frame([4095, 2048, 2048], [2048; 3])));
+        }
+        let r = got.unwrap();
+        assert!(r.voltage_fault() && !r.current_fault(), "{r:?}");
+    }
+
+    /// One count of jitter at an encoder edge is a standing shaft: the window goes on and
+    /// the zeros are re-trimmed.
+    #[test]
+    fn one_count_of_jitter_is_a_standing_shaft() {
+        let mut trim = OffsetTrim::new(&FrontEnd::DEFAULT);
+        for _ in 0..TRIM_SAMPLES {
+            trim.add(&frame_at([2048; 3], [2048; 3], 100));
+        }
+        let mut got = None;
+        for k in 0..TRIM_SAMPLES {
+            got = got.or(trim.add(&frame_at([2050; 3], [2050; 3], 100 + (k % 2) as u16)));
+        }
+        assert_eq!(got.map(|r| r.kind), Some(TrimKind::Retrim));
     }
 }

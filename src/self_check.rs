@@ -2,7 +2,7 @@
 //!
 //! Every remedy of the earlier reviews that lives in a register (the debug freeze, the clock
 //! security system, the encoder's mode, filter and latch, the ADCs' common register) or in
-//! the option bytes a user programs once (`CCMSRAM_RST`, `SRAM_PE`, nBOOT0, `IWDG_SW`,
+//! the option bytes a user programs once (`CCMSRAM_RST`, `SRAM_PE`, nBOOT0 and nSWBOOT0, `IWDG_SW`,
 //! `BFB2`, `DBANK`, the brown-out level) is read back at its address after it was written
 //! ([`registers`]: the table `cargo fw bring-up` reads over the probe too), and each register
 //! that does not hold the expected bits sets its bit in the run's [`Findings`]. The clock's
@@ -273,9 +273,11 @@ mod tests {
     }
 
     /// The G474's factory option bytes (0xFFEF_F8AA, RM0440) hold everything the firmware
-    /// wants but the brown-out level (0 at the factory): the self-check finds that one.
+    /// wants but the brown-out level (0 at the factory) and `nSWBOOT0` (1 at the factory:
+    /// the BOOT0 pin decides, `nBOOT0` has no effect): the self-check finds those two, and
+    /// `cargo fw bor` sets both.
     #[test]
-    fn the_factory_option_bytes_miss_only_the_brown_out_level() {
+    fn the_factory_option_bytes_miss_the_brown_out_level_and_the_boot_pin() {
         let e = expectation(ClockSource::Hse, None);
         let option_checks = [
             CheckId::CcmSramKept,
@@ -285,6 +287,7 @@ mod tests {
             CheckId::BootBank1,
             CheckId::DualBank,
             CheckId::BrownOutLevel,
+            CheckId::BootPinIgnored,
         ];
         let found = run(&option_checks, &e, |a| {
             assert_eq!(a, FLASH_OPTR);
@@ -292,9 +295,12 @@ mod tests {
         });
         assert_eq!(
             found.mismatched().collect::<Vec<_>>(),
-            [CheckId::BrownOutLevel]
+            [CheckId::BrownOutLevel, CheckId::BootPinIgnored]
         );
-        // One bit off each time: each check sees its own.
+        // After `cargo fw bor` (BOR_LEV = 4, nSWBOOT0 = 0, bit 26): nothing found; one bit
+        // off each time: each check sees its own.
+        let wanted = (0xFFEF_F8AA | (4 << 8)) & !(1 << 26);
+        assert!(run(&option_checks, &e, |_| wanted).is_clean());
         for (id, bit) in [
             (CheckId::CcmSramKept, OPTR_CCMSRAM_RST),
             (CheckId::SramParityOff, OPTR_SRAM_PE),
@@ -302,11 +308,13 @@ mod tests {
             (CheckId::WatchdogBySoftware, OPTR_IWDG_SW),
             (CheckId::BootBank1, OPTR_BFB2),
             (CheckId::DualBank, OPTR_DBANK),
+            (CheckId::BootPinIgnored, OPTR_NSWBOOT0),
         ] {
-            let optr = (0xFFEF_F8AA | (4 << 8)) ^ bit;
+            let optr = wanted ^ bit;
             let found = run(&option_checks, &e, |_| optr);
             assert_eq!(found.mismatched().collect::<Vec<_>>(), [id], "{id:?}");
         }
+        assert_eq!(OPTR_NSWBOOT0, 1 << 26);
     }
 
     /// The encoder's registers as embassy's `Qei::new` and the firmware's latch set them

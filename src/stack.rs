@@ -20,6 +20,10 @@
 //! ([`overflowed`]): only when the previous run painted it (a marker in `.uninit`,
 //! [`PAINTED`]), so power-on garbage is no overflow.
 
+/// The start of RAM (`memory.x`'s `RAM` origin, SRAM1 at 0x2000_0000 in RM0440's memory
+/// map): the stack's bottom with flip-link.
+pub const RAM_START: u32 = 0x2000_0000;
+
 /// The word the stack is painted with.
 pub const PAINT: u32 = 0x57AC_C0DE;
 /// The marker the firmware keeps in `.uninit` RAM once the stack is painted, so the next

@@ -319,3 +319,36 @@ fn a_power_cut_at_any_step_of_a_store_keeps_the_old_or_the_new_record() {
         ));
     }
 }
+
+/// With no valid copy, the boot's log names the reason that says most: a corrupt copy's
+/// (its CRC) over an erased page's, whichever page holds which.
+#[test]
+fn no_valid_copy_names_the_corrupt_page_over_the_erased_one() {
+    let mut corrupt = record().encode_copy(3).unwrap();
+    corrupt[20] ^= 0x10;
+    let erased = [0xFF; RECORD_LEN];
+    for pages in [[corrupt, erased], [erased, corrupt]] {
+        let mut flash = Cuttable {
+            pages,
+            unreadable: [false; 2],
+            cut_after: None,
+            powered: true,
+        };
+        assert_eq!(
+            load(&mut flash),
+            Err(LoadError::Record(RecordError::Crc)),
+            "{:?}",
+            pages.map(|p| p[0])
+        );
+    }
+    let mut flash = Cuttable {
+        pages: [erased; 2],
+        unreadable: [false; 2],
+        cut_after: None,
+        powered: true,
+    };
+    assert_eq!(
+        load(&mut flash),
+        Err(LoadError::Record(RecordError::Erased))
+    );
+}

@@ -1,7 +1,8 @@
-//! The acquisition's registers: [`AcqRegisters`] on the STM32G474's ADC1/ADC2 and DMA1
-//! channels 1/2. The recovery's sequence over them is `drive_monitor::recovery`'s
-//! [`RegisterAcquisition`] (the same code the host tests run on a register-level model);
-//! here are only the single register accesses, in RM0440's terms.
+//! The acquisition's hardware: [`AcqRegisters`] on the STM32G474's ADC1/ADC2 and DMA1
+//! channels 1/2/3, each register access one method of the register layer
+//! (`drive_monitor::regs`, held to RM0440 by `tests/registers.rs`), beside embassy's ring
+//! drivers. The recovery's sequence over them is `drive_monitor::recovery`'s
+//! [`RegisterAcquisition`] (the same code the host tests run on a register-level model).
 //!
 //! The ring-buffered ADCs of embassy-stm32 own the DMA channels; what they do not offer
 //! (stopping a conversion, clearing `DMAEN` and setting it again, clearing `OVR`/`EOC`/`EOS`
@@ -12,23 +13,15 @@ use core::marker::PhantomData;
 use drive_monitor::acquisition::{DMA_HALF_LEN, LATCH_HALF_LEN};
 use drive_monitor::adc_rules::AdcPairSetup;
 use drive_monitor::recovery::{AcqRegisters, Acquisition, AdcFlags, RegisterAcquisition};
+use drive_monitor::regs::MCU;
 use drive_monitor::ring_read::{RingRead, RingReads};
 use embassy_stm32::adc::RingBufferedAdc;
 use embassy_stm32::adc::{Adc, AdcConfig};
 use embassy_stm32::dma::{self, ReadableRingBuffer};
 use embassy_stm32::interrupt::typelevel::Handler;
-use embassy_stm32::pac;
-use embassy_stm32::pac::adc::vals::{Dmacfg, Dmaen};
 use embassy_stm32::timer::low_level::Timer as HwTimer;
 use embassy_stm32::{peripherals, Peri};
 use embassy_time::{with_deadline, Duration, Instant};
-
-/// The two ADCs' registers, ADC1 (voltages) then ADC2 (currents).
-const ADCS: [pac::adc::Adc; 2] = [pac::ADC1, pac::ADC2];
-/// The DMA1 channels of the two rings (register index: channel 1 is index 0).
-const DMA_CHANNELS: [usize; 2] = [0, 1];
-/// The DMA1 channel of the encoder latch's ring (channel 3).
-const LATCH_CHANNEL: usize = 2;
 
 /// The acquisition: trigger timer and the two ring-buffered ADCs, as the recovery drives
 /// them ([`RegisterAcquisition`] over [`HwRegisters`]).
@@ -65,9 +58,7 @@ pub(super) fn new_acquisition(
     latch: ReadableRingBuffer<'static, u16>,
     (ring_len, timeout): (u16, Duration),
 ) -> HwAcquisition {
-    for n in DMA_CHANNELS.into_iter().chain([LATCH_CHANNEL]) {
-        pac::DMA1.ch(n).cr().modify(|w| w.set_teie(false));
-    }
+    MCU.dma_errors_masked();
     RegisterAcquisition {
         regs: HwRegisters {
             trigger,
@@ -103,15 +94,15 @@ impl AdcPairSetup for HwPair {
     }
 
     fn cr(&mut self, i: usize) -> u32 {
-        adc(i).cr().read().0
+        MCU.adc_cr(i)
     }
 
     fn write_cr(&mut self, i: usize, value: u32) {
-        adc(i).cr().write_value(pac::adc::regs::Cr(value));
+        MCU.adc_cr_write(i, value);
     }
 
     fn prescaler(&mut self) -> u32 {
-        u32::from(pac::ADC12_COMMON.ccr().read().presc().to_bits())
+        MCU.adc_prescaler()
     }
 }
 
@@ -127,80 +118,41 @@ pub(super) fn start(acq: &mut HwAcquisition) {
     acq.start_trigger();
 }
 
-/// ADC `i`'s registers (0: ADC1, else ADC2).
-fn adc(i: usize) -> pac::adc::Adc {
-    if i == 0 {
-        ADCS[0]
-    } else {
-        ADCS[1]
-    }
-}
-
-/// DMA channel `i`'s register index.
-fn dma(i: usize) -> usize {
-    if i == 0 {
-        DMA_CHANNELS[0]
-    } else {
-        DMA_CHANNELS[1]
-    }
-}
-
 impl AcqRegisters for HwRegisters {
     fn adc_flags(&mut self, i: usize) -> AdcFlags {
-        let isr = adc(i).isr().read();
-        AdcFlags {
-            ovr: isr.ovr(),
-            eoc: isr.eoc(),
-            eos: isr.eos(),
-        }
+        MCU.adc_flags(i)
     }
 
     fn adc_clear(&mut self, i: usize, f: AdcFlags) {
-        // Write 1 to clear; the other flags are left as they are.
-        adc(i).isr().write(|w| {
-            w.set_ovr(f.ovr);
-            w.set_eoc(f.eoc);
-            w.set_eos(f.eos);
-        });
+        MCU.adc_clear(i, f);
     }
 
     fn adc_cr(&mut self, i: usize) -> u32 {
-        adc(i).cr().read().0
+        MCU.adc_cr(i)
     }
 
     fn adc_cr_write(&mut self, i: usize, value: u32) {
-        // The whole register as the sequence computed it (`adc_rules::cr_setting`: one
-        // set-only bit, the ordinary bits as read), not a read-modify-write.
-        adc(i).cr().write_value(pac::adc::regs::Cr(value));
+        MCU.adc_cr_write(i, value);
     }
 
     fn adc_dma_circular(&mut self, i: usize) {
-        adc(i).cfgr().modify(|w| {
-            w.set_dmaen(Dmaen::ENABLE);
-            w.set_dmacfg(Dmacfg::CIRCULAR);
-        });
+        MCU.adc_dma_circular(i);
     }
 
     fn adc_dma_off(&mut self, i: usize) {
-        adc(i).cfgr().modify(|w| w.set_dmaen(Dmaen::DISABLE));
+        MCU.adc_dma_off(i);
     }
 
     fn dma_error(&mut self, i: usize) -> bool {
-        pac::DMA1.isr().read().teif(dma(i))
+        MCU.dma_error(i)
     }
 
     fn dma_clear(&mut self, i: usize) {
-        let n = dma(i);
-        pac::DMA1.ifcr().write(|w| {
-            w.set_teif(n, true);
-            w.set_htif(n, true);
-            w.set_tcif(n, true);
-            w.set_gif(n, true);
-        });
+        MCU.dma_clear(i);
     }
 
     fn dma_enabled(&mut self, i: usize) -> bool {
-        pac::DMA1.ch(dma(i)).cr().read().en()
+        MCU.dma_enabled(i)
     }
 
     fn dma_disable(&mut self, i: usize) {
@@ -214,7 +166,7 @@ impl AcqRegisters for HwRegisters {
     fn dma_reload(&mut self, i: usize, transfers: u16) {
         // The whole ring again, from its start (the channel is off: CNDTR is writable);
         // the ring's read and write positions from the reloaded counter.
-        pac::DMA1.ch(dma(i)).ndtr().write(|w| w.set_ndt(transfers));
+        MCU.dma_reload(i, transfers);
         if i == 0 {
             self.adc1.clear();
         } else {
@@ -223,12 +175,11 @@ impl AcqRegisters for HwRegisters {
     }
 
     fn dma_enable(&mut self, i: usize) {
-        pac::DMA1.ch(dma(i)).cr().modify(|w| w.set_en(true));
+        MCU.dma_enable(i);
     }
 
     fn latch_request(&mut self, on: bool) {
-        // TIM4's capture DMA request on channel 3 (withdrawn when cleared).
-        pac::TIM4.dier().modify(|w| w.set_ccde(2, on));
+        MCU.latch_request(on);
     }
 
     fn latch_disable(&mut self) {
@@ -236,28 +187,20 @@ impl AcqRegisters for HwRegisters {
     }
 
     fn latch_enabled(&mut self) -> bool {
-        pac::DMA1.ch(LATCH_CHANNEL).cr().read().en()
+        MCU.latch_enabled()
     }
 
     fn latch_clear(&mut self) {
-        pac::DMA1.ifcr().write(|w| {
-            w.set_teif(LATCH_CHANNEL, true);
-            w.set_htif(LATCH_CHANNEL, true);
-            w.set_tcif(LATCH_CHANNEL, true);
-            w.set_gif(LATCH_CHANNEL, true);
-        });
+        MCU.latch_clear();
     }
 
     fn latch_reload(&mut self, transfers: u16) {
-        pac::DMA1
-            .ch(LATCH_CHANNEL)
-            .ndtr()
-            .write(|w| w.set_ndt(transfers));
+        MCU.latch_reload(transfers);
         self.latch.clear();
     }
 
     fn latch_enable(&mut self) {
-        pac::DMA1.ch(LATCH_CHANNEL).cr().modify(|w| w.set_en(true));
+        MCU.latch_enable();
     }
 
     fn trigger_stop(&mut self) {
@@ -312,11 +255,8 @@ pub(super) struct AdcDmaInterrupt<T: dma::ChannelInstance, const N: usize> {
 impl<T: dma::ChannelInstance, const N: usize> Handler<T::Interrupt> for AdcDmaInterrupt<T, N> {
     #[allow(unsafe_code)]
     unsafe fn on_interrupt() {
-        if pac::DMA1.isr().read().teif(N) {
-            pac::DMA1.ifcr().write(|w| {
-                w.set_htif(N, true);
-                w.set_tcif(N, true);
-            });
+        if MCU.dma_channel_error(N) {
+            MCU.dma_acknowledge_transfers(N);
             return;
         }
         // SAFETY: called from this channel's interrupt, as embassy's handler expects.

@@ -9,14 +9,13 @@
 use core::sync::atomic::Ordering;
 
 use drive_monitor::app::WATCHDOG_TIMEOUT_MS;
-use drive_monitor::board::{Lamp, Port};
 use drive_monitor::clock::CYCLES_PER_MS;
 use drive_monitor::fault_path::{self, FaultBoard, FaultEnd, FaultGuard, FaultRegisters};
 use drive_monitor::flash_ecc::{self, EccLatch, NmiAction};
 use drive_monitor::panel::PanelLamps;
+use drive_monitor::regs::MCU;
 use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::supply::BorLevel;
-use embassy_stm32::pac;
 
 use super::reset_ram::{write_reset_record, FINDINGS, PHASE};
 use super::supply::bor_level;
@@ -43,43 +42,20 @@ impl FaultBoard for Registers {
     }
 
     fn show_failed(&mut self) {
-        // Direct register writes: the HAL objects may be in any state. GPIO clocks are
-        // enabled by `embassy_stm32::init` for every port.
-        use pac::gpio::vals::Moder;
-        for lamp in Lamp::ALL {
-            let pin = lamp.pin();
-            let port = match pin.port {
-                Port::A => pac::GPIOA,
-                Port::B => pac::GPIOB,
-                Port::C => pac::GPIOC,
-                Port::D => pac::GPIOD,
-                Port::E => pac::GPIOE,
-                Port::F => pac::GPIOF,
-                Port::G => pac::GPIOG,
-            };
-            let n = usize::from(pin.number);
-            port.moder().modify(|w| w.set_moder(n, Moder::OUTPUT));
-            if PanelLamps::FAILED.is_on(lamp) {
-                port.bsrr().write(|w| w.set_bs(n, true));
-            } else {
-                port.bsrr().write(|w| w.set_br(n, true));
-            }
-        }
+        // Direct register writes: the HAL objects may be in any state.
+        MCU.show_lamps(|lamp| PanelLamps::FAILED.is_on(lamp));
     }
 }
 
 /// The fault status registers with the stacked `pc` and `lr`.
-#[allow(unsafe_code)]
 fn fault_registers(pc: u32, lr: u32) -> FaultRegisters {
-    // SAFETY: the System Control Block's fault status registers, only read; the handlers
-    // run with interrupts off and never return.
-    let scb = unsafe { &*cortex_m::peripheral::SCB::PTR };
+    let status = MCU.fault_status();
     FaultRegisters {
         pc,
         lr,
-        cfsr: scb.cfsr.read(),
-        hfsr: scb.hfsr.read(),
-        bfar: scb.bfar.read(),
+        cfsr: status.cfsr,
+        hfsr: status.hfsr,
+        bfar: status.bfar,
     }
 }
 
@@ -110,12 +86,12 @@ unsafe fn NonMaskableInt() {
     // SAFETY (cortex-m-rt asks for an `unsafe fn`: an NMI can preempt anything, even a
     // critical section): the handler touches only `FLASH_ECCR`, the `ECC` latch (an
     // atomic) and, for a fault, the fault path, which never returns.
-    let eccr = pac::FLASH.eccr().read();
-    match flash_ecc::nmi_cause(pac::RCC.cifr().read().0, eccr.0) {
+    let (cifr, eccr) = MCU.nmi_sources();
+    match flash_ecc::nmi_cause(cifr, eccr) {
         NmiAction::ClockFailure => {
             // The hardware runs SYSCLK from the HSI now. Clear CSSF (the NMI would pend
             // again), record the failure, reset: the next boot runs the PLL from the HSI.
-            pac::RCC.cicr().write(|w| w.set_cssc(true));
+            MCU.clear_clock_failure();
             cortex_m::interrupt::disable();
             end(fault_path::on_fault(
                 &GUARD,
@@ -125,11 +101,7 @@ unsafe fn NonMaskableInt() {
         }
         NmiAction::RecordPageEcc(e) => {
             ECC.latch(e);
-            // Write 1 to clear ECCD (and ECCC); the other bits are read-only or enables.
-            pac::FLASH.eccr().modify(|w| {
-                w.set_eccd(true);
-                w.set_eccc(true);
-            });
+            MCU.clear_ecc();
         }
         NmiAction::Fault => {
             cortex_m::interrupt::disable();

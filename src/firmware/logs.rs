@@ -341,6 +341,11 @@ pub(super) fn log_reset_log(written: Result<log::Written, FlashError>) {
             log::FULL_ENTRIES
         ),
         Ok(log::Written::Counted { failed: false }) => {}
+        Ok(log::Written::Pending { failed }) => info!(
+            "reset log: counted in RAM (failed run {=bool}), written with the next {=u32} or after a run that is up",
+            failed,
+            log::FLUSH_AFTER
+        ),
         Err(e) => warn!("reset log: not written: {}", e),
     }
 }

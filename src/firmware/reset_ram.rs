@@ -8,8 +8,9 @@
 use core::mem::MaybeUninit;
 use core::sync::atomic::{AtomicU32, AtomicU8, Ordering};
 
-use drive_monitor::boot_block::{BootBlock, BOOT_BLOCK_LEN};
-use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::boot_block::{BootBlock, Pending, BOOT_BLOCK_LEN};
+use drive_monitor::reset_record::{log, BootPhase, ResetRecord, RESET_RECORD_LEN};
+use drive_monitor::startup::BootFacts;
 use drive_monitor::supply::BorLevel;
 
 /// What the firmware is doing ([`BootPhase::number`]), for the record of a `defmt` panic.
@@ -44,6 +45,35 @@ pub(super) fn mark_up(long: bool) {
             write_boot_block(&block.marked_up(long).encode());
         }
     });
+}
+
+/// Keeps the reset log's counts not yet in flash (`pending`) in the boot block, in a
+/// critical section (`drive_monitor::reset_record::log::record_boot` and `count_safe_mode`
+/// decide them at boot).
+pub(super) fn set_pending(pending: Pending) {
+    cortex_m::interrupt::free(|_| {
+        if let Some(block) = BootBlock::decode(&read_boot_block()) {
+            write_boot_block(&BootBlock { pending, ..block }.encode());
+        }
+    });
+}
+
+/// The safe mode's boot counted in the boot block's RAM (`log::count_safe_mode`); no flash
+/// is touched. Whether it was counted (`false`: every slot held another count).
+pub(super) fn count_safe_mode(facts: &BootFacts) -> bool {
+    let boot = log::BootRecord {
+        previous: facts.previous,
+        source: facts.reset_source,
+        kind: facts.history.kind,
+        previous_long_up: facts.history.previous_long_up,
+        previous_up: facts.history.previous_up,
+        ram_kept: facts.history.ram_kept,
+        safe_mode: true,
+    };
+    let mut pending = facts.history.pending;
+    let counted = log::count_safe_mode(&mut pending, &boot);
+    set_pending(pending);
+    counted
 }
 
 /// Writes `record` into the reset record with the brown-out level in force (`bor`,

@@ -17,6 +17,7 @@ use drive_monitor::clock::ClockSource;
 use drive_monitor::liveness::AdcWait;
 use drive_monitor::motor_source::EncoderSetup;
 use drive_monitor::recovery::{self, RecoveryCounts, StepTimeout};
+use drive_monitor::regs::{self, MCU};
 use drive_monitor::reset_record::{BootPhase, ResetRecord, RESET_RECORD_LEN};
 use drive_monitor::ring_read::{self, Half, HalfBuffers};
 use drive_monitor::self_check::{self, CheckId, EncoderExpected};
@@ -27,13 +28,13 @@ use embassy_stm32::gpio::Pull;
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::low_level::{MasterMode, RoundTo, Timer as HwTimer};
 use embassy_stm32::timer::qei::{Config as QeiConfig, Qei};
-use embassy_stm32::{pac, peripherals, triggers, Peri};
+use embassy_stm32::{peripherals, triggers, Peri};
 use embassy_time::{with_timeout, Duration};
 
 use super::acquisition::{self, HwAcquisition};
+use super::logs;
 use super::reset_ram::{self, mark_phase, set_phase, write_reset_record};
 use super::supply;
-use super::{logs, startup_hw};
 use super::{
     Irqs, Status, COMMANDS, OVERRUNS, PAUSED, PAUSE_LIMIT_MS, REFERENCE, RESTARTS, RESUME,
     SETTINGS, STATUS, TRIM,
@@ -82,26 +83,9 @@ fn start_encoder(
     };
     let qei = Qei::new(tim4, a, b, qei_config);
     // The input filter on both inputs and the direction (input A's polarity), from the
-    // motor record (`motor_source::encoder_setup`).
-    let regs = pac::TIM4;
-    let filter = pac::timer::vals::FilterValue::from_bits(setup.input_filter);
-    regs.ccmr_input(0).modify(|w| {
-        w.set_icf(0, filter);
-        w.set_icf(1, filter);
-    });
-    regs.ccer().modify(|w| w.set_ccp(0, setup.invert_a));
-    // The count latched at the sample trigger: channel 3 captures the counter on TRC, the
-    // internal trigger ITR0 (TIM1's TRGO, RM0440 "TIMx internal trigger connection"; the
-    // encoder mode does not use the trigger input), rising edge, and each capture raises
-    // a DMA request (`CC3DE`) that copies `CCR3` into the latch's ring.
-    regs.smcr().modify(|w| w.set_ts(pac::timer::vals::Ts::ITR0));
-    regs.ccmr_input(1)
-        .modify(|w| w.set_ccs(0, pac::timer::vals::CcmrInputCcs::TRC));
-    regs.ccer().modify(|w| {
-        w.set_ccp(2, false);
-        w.set_cce(2, true);
-    });
-    regs.dier().modify(|w| w.set_ccde(2, true));
+    // motor record (`motor_source::encoder_setup`), and the count latched at the sample
+    // trigger (`drive_monitor::regs`' `encoder_setup`).
+    MCU.encoder_setup(setup.input_filter, setup.invert_a);
     qei
 }
 
@@ -113,7 +97,7 @@ fn latch_ring(
 ) -> ReadableRingBuffer<'static, u16> {
     use embassy_stm32::timer::{Ch3, Dma as TimerDma};
     let request = TimerDma::<peripherals::TIM4, Ch3>::request(&*dma);
-    let ccr3 = pac::TIM4.ccr(2).as_ptr() as *mut u16;
+    let ccr3 = MCU.latch_source();
     // Circular with the half- and full-transfer interrupts (the ring buffer sets them).
     let options = TransferOptions::default();
     #[allow(unsafe_code)]
@@ -132,8 +116,7 @@ fn latch_ring(
 /// motor); the datasheet's bound on
 /// the source resistance, R_AIN < t_S / (f_ADC C_ADC ln(2^(N+2))) - R_ADC, with C_ADC
 /// 5 pF and R_ADC 1 kohm, is about 11 kohm at 24.5 cycles.
-const SAMPLE_TIME: SampleTime = SampleTime::CYCLES24_5;
-const _: () = assert!(geometry::SAMPLE_TIME_HALF_CYCLES == 49);
+const SAMPLE_TIME: SampleTime = regs::acquisition::SAMPLE_TIME;
 const _: () = assert!(
     geometry::ring_fits(SETTINGS.sample_rate_hz, geometry::SAMPLES_PER_HALF as u32),
     "the DMA ring does not cover the worst-case latency at the sample rate"
@@ -406,7 +389,7 @@ fn set_up_acquisition(
     // The acquisition's registers read back (the encoder's timer, the ADCs' common
     // register): each mismatch logged and carried by every later reset record.
     let expectation = self_check::expectation(clock, Some(expected));
-    let findings = self_check::run(&CheckId::ACQUISITION, &expectation, startup_hw::read_word);
+    let findings = self_check::run(&CheckId::ACQUISITION, &expectation, |a| MCU.read_word(a));
     reset_ram::FINDINGS.fetch_or(findings.0, Ordering::Relaxed);
     findings.mismatched().for_each(logs::log_mismatch);
     started

@@ -5,7 +5,7 @@
 
 use core::mem::MaybeUninit;
 
-use drive_monitor::stack::{self, GUARD_WORDS, PAINT, PAINTED, PAINT_MARGIN_BYTES};
+use drive_monitor::stack::{self, GUARD_WORDS, PAINT, PAINTED, PAINT_MARGIN_BYTES, RAM_START};
 
 extern "C" {
     /// cortex-m-rt's initial stack pointer (the top of the stack).
@@ -13,9 +13,6 @@ extern "C" {
     /// cortex-m-rt's end of the statics (`.uninit`): the stack's bottom without flip-link.
     static _stack_end: u32;
 }
-
-/// The start of RAM (`memory.x`).
-const RAM_START: u32 = 0x2000_0000;
 
 /// [`PAINTED`] once this run painted its stack (RAM that survives a reset).
 #[allow(unsafe_code)]

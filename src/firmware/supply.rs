@@ -6,11 +6,10 @@ use core::sync::atomic::{AtomicU8, Ordering};
 
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
+use drive_monitor::clock;
+use drive_monitor::regs::MCU;
 use drive_monitor::setup_guard::{self, SetupStep, SETUP_DEADLINE_MS};
 use drive_monitor::supply::{BorLevel, ReferenceAdc};
-use drive_monitor::{adc_rules, clock};
-use embassy_stm32::pac;
-use embassy_stm32::pac::adc::vals::{Exten, SampleTime};
 
 use super::reset_ram;
 
@@ -68,28 +67,15 @@ fn SysTick() {
 
 /// The brown-out level in force (`FLASH_OPTR.BOR_LEV`; `None` for a reserved value).
 pub(super) fn bor_level() -> Option<BorLevel> {
-    BorLevel::from_optr(pac::FLASH.optr().read().0)
+    BorLevel::from_optr(MCU.optr())
 }
 
-/// ADC1's VREFINT channel (RM0440, "ADC1 connectivity": ADC1_IN18).
-const VREFINT_CHANNEL: u8 = 18;
-
-/// Sets ADC1's injected sequence to one conversion of VREFINT, software-triggered, with
-/// 247.5 cycles of sampling time (5.8 us; VREFINT needs at least 4 us, datasheet
-/// `t_S_vrefint`); the VREFINT buffer is switched on by the measurement
-/// (`supply::measure_now`, then its start-up time). Call with ADC1
-/// enabled and `ADSTART = JADSTART = 0` (after `into_ring_buffered`, before the ring
-/// starts): `SMPR2` and `JSQR` are writable only then. The regular sequence's sample
-/// times are `SMPR1` and channels 10..17 of `SMPR2`; channel 18's field is this one's.
+/// Sets ADC1's injected sequence to one conversion of VREFINT
+/// (`drive_monitor::regs`' `configure_reference`); the VREFINT buffer is switched on by the
+/// measurement (`supply::measure_now`, then its start-up time). Call with ADC1 enabled and
+/// `ADSTART = JADSTART = 0` (after `into_ring_buffered`, before the ring starts).
 pub(super) fn configure_reference() {
-    let adc = pac::ADC1;
-    adc.smpr2()
-        .modify(|w| w.set_smp(usize::from(VREFINT_CHANNEL - 10), SampleTime::CYCLES247_5));
-    adc.jsqr().write(|w| {
-        w.set_jl(0);
-        w.set_jexten(Exten::DISABLED);
-        w.set_jsq(0, VREFINT_CHANNEL);
-    });
+    MCU.configure_reference();
 }
 
 /// VREFINT on ADC1's injected channel ([`ReferenceAdc`]). An injected conversion started
@@ -100,11 +86,11 @@ pub(super) struct HwReference;
 
 impl ReferenceAdc for HwReference {
     fn calibration(&self) -> u16 {
-        pac::VREFINTCAL.data().read()
+        MCU.vrefint_calibration()
     }
 
     fn enable(&mut self) {
-        pac::ADC12_COMMON.ccr().modify(|w| w.set_vrefen(true));
+        MCU.vrefint_enable();
     }
 
     fn wait_us(&mut self, us: u32) {
@@ -115,24 +101,10 @@ impl ReferenceAdc for HwReference {
         // JADSTART written alone (`adc_rules::cr_setting`: no other set-only bit written
         // back), in a critical section: the sample task's recovery writes ADC1_CR too
         // (ADSTP, ADSTART), and its read and write must not interleave with this one.
-        cortex_m::interrupt::free(|_| {
-            let cr = pac::ADC1.cr().read().0;
-            let value = adc_rules::cr_setting(cr, adc_rules::JADSTART);
-            pac::ADC1.cr().write_value(pac::adc::regs::Cr(value));
-        });
+        cortex_m::interrupt::free(|_| MCU.start_injected());
     }
 
     fn result(&mut self) -> Option<u16> {
-        let adc = pac::ADC1;
-        if !adc.isr().read().jeos() {
-            return None;
-        }
-        let code = adc.jdr(0).read().jdata();
-        // Write 1 to clear JEOS and JEOC only; the regular flags stay as they are.
-        adc.isr().write(|w| {
-            w.set_jeos(true);
-            w.set_jeoc(true);
-        });
-        Some(code)
+        MCU.injected_result()
     }
 }

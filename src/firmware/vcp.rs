@@ -3,19 +3,18 @@
 //! reads without a probe.
 
 use defmt::error;
-use drive_monitor::clock::ClockSource;
 use drive_monitor::reset_record::{log, report};
-use drive_monitor::self_check::CheckId;
-use drive_monitor::startup::{BootFacts, SafeModeReason};
+use drive_monitor::startup::BootFacts;
 use embassy_stm32::usart::{Config as UsartConfig, UartTx};
 use embassy_stm32::{peripherals, Peri};
 
 use super::flash::{BoardFlash, LogPages};
-use super::logs;
+use super::{logs, reset_ram};
 
 /// The record a technician reads without a probe: the boot's item in the reset log in flash
-/// (`log::record_boot`: a full entry for a failed run within the rate limit, else a count;
-/// refused below the brown-out goal; before sampling starts, so an erase holds nothing up),
+/// (`log::record_boot`: a full entry for a failed run within the rate limit, else a count,
+/// kept in the boot block's RAM until its write is due; refused below the brown-out goal;
+/// before sampling starts, so an erase holds nothing up),
 /// then the boot report, the self-check's findings, the safe mode, the log's counts and its
 /// four newest entries as text on the ST-LINK's virtual COM port (USART2 TX on PA2,
 /// 115 200 8N1; `drive_monitor::reset_record::report`).
@@ -36,22 +35,32 @@ pub(super) fn report_boot(
         source: facts.reset_source,
         kind: facts.history.kind,
         previous_long_up: facts.history.previous_long_up,
-        safe_mode: facts.safe_mode.is_some(),
+        previous_up: facts.history.previous_up,
+        ram_kept: facts.history.ram_kept,
+        safe_mode: false,
     };
-    logs::log_reset_log(log::record_boot(&mut pages, &boot));
+    let mut pending = facts.history.pending;
+    logs::log_reset_log(log::record_boot(&mut pages, &boot, &mut pending));
+    reset_ram::set_pending(pending);
     let Ok(mut vcp) = UartTx::new_blocking(usart, tx, UsartConfig::default()) else {
         error!("virtual COM port: USART2 not configured: no boot report there");
         return;
     };
-    let head = head_lines(facts);
-    let totals = report::totals_line(&log::totals(&mut pages));
-    let mut lines = head.into_iter().flatten().chain([totals]).chain(
-        log::newest::<_, 4>(&mut pages)
-            .0
-            .into_iter()
-            .flatten()
-            .map(|e| report::entry_line(&e)),
-    );
+    let head = report::head_lines(env!("CARGO_PKG_VERSION"), facts);
+    let totals = report::totals_line(&pending.added_to(log::totals(&mut pages)));
+    let waiting = report::pending_line(pending.count());
+    let mut lines = head
+        .into_iter()
+        .flatten()
+        .chain([totals])
+        .chain(waiting)
+        .chain(
+            log::newest::<_, 4>(&mut pages)
+                .0
+                .into_iter()
+                .flatten()
+                .map(|e| report::entry_line(&e)),
+        );
     if lines
         .try_for_each(|l| vcp.blocking_write(l.as_bytes()))
         .is_err()
@@ -61,31 +70,28 @@ pub(super) fn report_boot(
     let _ = vcp.blocking_flush();
 }
 
-/// The report's first lines: the boot line, the previous run's end, the self-check's
-/// findings and the safe mode (when there are any).
-fn head_lines(facts: &BootFacts) -> [Option<report::ReportLine>; 4] {
-    let clock = match facts.clock {
-        Some(ClockSource::Hse) => "24 MHz crystal (HSE)",
-        Some(_) => "internal oscillator (HSI, +-1 %)",
-        None => "16 MHz reset clock (safe mode)",
+/// The safe mode's report on the virtual COM port (`report::safe_mode_report`): the boot
+/// line, the previous run, the findings, the safe mode's line and that the reset log is not
+/// read. No flash is touched: the safe mode does not depend on the log's scan.
+pub(super) fn report_safe_mode(
+    (usart, tx): (
+        Peri<'static, peripherals::USART2>,
+        Peri<'static, peripherals::PA2>,
+    ),
+    facts: &BootFacts,
+) {
+    let Ok(mut vcp) = UartTx::new_blocking(usart, tx, UsartConfig::default()) else {
+        error!("virtual COM port: USART2 not configured: no boot report there");
+        return;
     };
-    let version = env!("CARGO_PKG_VERSION");
-    let bor = facts.bor.status_number();
-    let findings = report::list_line(
-        "self-check: did not take: ",
-        facts.findings.mismatched().map(CheckId::name),
-    );
-    let safe = facts.safe_mode.map(|reason| {
-        let why = match reason {
-            SafeModeReason::BootLoop { .. } => "boots in a row failed before the monitor was up",
-            SafeModeReason::PllDidNotLock => "the PLL did not lock",
-        };
-        report::safe_mode_line(reason.code(), why)
-    });
-    [
-        Some(report::boot_line(version, facts.reset_source, bor, clock)),
-        Some(report::previous_line(&facts.previous)),
-        findings,
-        safe,
-    ]
+    let lines = report::safe_mode_report(env!("CARGO_PKG_VERSION"), facts);
+    if lines
+        .iter()
+        .flatten()
+        .try_for_each(|l| vcp.blocking_write(l.as_bytes()))
+        .is_err()
+    {
+        error!("virtual COM port: write failed");
+    }
+    let _ = vcp.blocking_flush();
 }

@@ -3,7 +3,7 @@
 //! second.
 //!
 //! The reset record lives in RAM ([`super::ResetRecord`]) and is lost with the supply. At
-//! every boot the firmware writes one item to this log ([`record_boot`]): a **full entry**
+//! every boot the firmware counts one item in this log ([`record_boot`]): a **full entry**
 //! (152 bytes: a sequence number, the reset's source and kind, how the previous run ended,
 //! the 128-byte reset record) for a failed run, or a **count mark** (8 bytes: the reset's
 //! kind, a count) for everything else: a power-on, a brown-out, the reset button, and a
@@ -22,11 +22,19 @@
 //! starts with the totals carried over: the counts are never lost with an erased page, the
 //! oldest entries are.
 //!
-//! **Wear.** A page holds [`MARKS_PER_PAGE`] (248) marks. A boot every second for a year is
-//! 31 536 000 boots: at most 31 536 000 marks (plus [`FULL_ENTRIES`] entries for each 10
-//! minutes a run was up, which a boot every second never is), 127 162 page fills, spread
-//! over 16 pages: 7 948 erases a page, within the 10 000 cycles a page survives (DS12288).
-//! A boot every second lasts 1.26 years; a board that boots once a day, thousands of years.
+//! **Counts wait in RAM.** A count is not written at its boot but kept in RAM that survives
+//! the reset ([`Pending`], in the boot block) until its write is due ([`record_boot`]): after
+//! a power-on (RAM kept nothing: at once), after a run that was up (10 s of samples), after
+//! the safe mode (which touches no flash, [`count_safe_mode`]), when [`FLUSH_AFTER`] boots
+//! wait or the slots are full. A boot whose count waits reads no flash.
+//!
+//! **Wear.** A page holds [`MARKS_PER_PAGE`] (248) marks. A supply chattering at the
+//! brown-out threshold ten times a second for a year (RAM kept) is 315 360 000 boots, one
+//! mark every 64: 4 927 500 marks, 19 869 page fills over 16 pages, 1 242 erases a page
+//! (with four kinds waiting at once, four marks a write, 4 967), within the 10 000 cycles a
+//! page survives (DS12288); a count a boot wore it out in 46 days. A power-on's count is
+//! written at once: a supply that collapses fully every second wears the log in 1.26 years
+//! (31 536 000 marks, 7 948 erases a page).
 //!
 //! **Torn writes.** An item is 8-byte aligned and written once; a write a power loss cut
 //! short leaves a torn item (neither erased nor valid): it is skipped, never read as an
@@ -209,7 +217,7 @@ fn source_of(code: u8) -> ResetSource {
 
 /// A count mark: `count` more of `what` (a [`ResetKind`]'s index, or [`UP`]) with its
 /// flags.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 struct Mark {
     what: usize,
     count: u16,
@@ -218,11 +226,16 @@ struct Mark {
 }
 
 impl Mark {
+    /// The mark's second byte: what it counts and its flags.
+    fn flags_byte(&self) -> u8 {
+        self.what as u8
+            | (u8::from(self.failed) * MARK_FAILED)
+            | (u8::from(self.safe_mode) * MARK_SAFE_MODE)
+    }
+
     fn encode(&self) -> [u8; MARK_LEN] {
-        let flags =
-            (u8::from(self.failed) * MARK_FAILED) | (u8::from(self.safe_mode) * MARK_SAFE_MODE);
         let [c0, c1] = self.count.to_le_bytes();
-        let head = [MARK_TAG, self.what as u8 | flags, c0, c1];
+        let head = [MARK_TAG, self.flags_byte(), c0, c1];
         let [k0, k1, k2, k3] = (!u32::from_le_bytes(head)).to_le_bytes();
         let [h0, h1, h2, h3] = head;
         [h0, h1, h2, h3, k0, k1, k2, k3]
@@ -347,6 +360,120 @@ pub trait LogFlash {
     /// # Errors
     /// When the write fails or is refused.
     fn write(&mut self, page: usize, offset: usize, bytes: &[u8]) -> Result<(), Self::Error>;
+}
+
+/// Slots of counts kept in RAM ([`Pending`]).
+pub const PENDING_SLOTS: usize = 4;
+/// Bytes of [`Pending`] in the boot block.
+pub const PENDING_LEN: usize = 4 * PENDING_SLOTS;
+/// Boots counted in RAM after which the boot writes them ([`record_boot`], module docs).
+pub const FLUSH_AFTER: u32 = 64;
+
+/// Counts not yet in flash, kept in RAM that survives a reset (the boot block,
+/// `crate::boot_block`): up to [`PENDING_SLOTS`] marks, each a reset's kind with its flags
+/// and a count. A boot adds its count here instead of writing it ([`record_boot`]) unless
+/// something makes the write due; the counts then go to flash together, one mark a slot.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Pending {
+    slots: [Mark; PENDING_SLOTS],
+}
+
+impl Pending {
+    /// Nothing pending.
+    pub const EMPTY: Pending = Pending {
+        slots: [Mark {
+            what: 0,
+            count: 0,
+            failed: false,
+            safe_mode: false,
+        }; PENDING_SLOTS],
+    };
+
+    /// One more reset of `kind` (`failed`: the run it follows failed; `safe_mode`: this
+    /// boot entered the safe mode), in the slot of the same kind and flags or a free one;
+    /// `false` when every slot holds another (nothing counted).
+    pub fn add(&mut self, kind: ResetKind, failed: bool, safe_mode: bool) -> bool {
+        let what = kind.index();
+        let same = |m: &Mark| m.what == what && m.failed == failed && m.safe_mode == safe_mode;
+        let slot = match self.slots.iter().position(|m| m.count > 0 && same(m)) {
+            Some(i) => self.slots.get_mut(i),
+            None => self.slots.iter_mut().find(|m| m.count == 0),
+        };
+        match slot {
+            Some(m) if m.count < u16::MAX => {
+                *m = Mark {
+                    what,
+                    count: m.count + 1,
+                    failed,
+                    safe_mode,
+                };
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// The boots counted.
+    pub fn count(&self) -> u32 {
+        self.slots.iter().map(|m| u32::from(m.count)).sum()
+    }
+
+    /// Whether a boot that entered the safe mode is among them (the next boot writes them).
+    pub fn holds_safe_mode(&self) -> bool {
+        self.slots.iter().any(|m| m.count > 0 && m.safe_mode)
+    }
+
+    /// The marks to write, one a slot in use.
+    fn marks(&self) -> impl Iterator<Item = Mark> + '_ {
+        self.slots.iter().copied().filter(|m| m.count > 0)
+    }
+
+    /// `totals` with these counts added (what the boot report shows).
+    pub fn added_to(&self, mut totals: Totals) -> Totals {
+        for m in self.marks() {
+            totals.add_mark(&m);
+        }
+        totals
+    }
+
+    /// The bytes kept in the boot block: a slot is its kind and flags (a mark's second
+    /// byte), a reserved byte and the count (little-endian); a free slot's count is 0.
+    pub fn encode(&self) -> [u8; PENDING_LEN] {
+        let mut out = [0u8; PENDING_LEN];
+        for (m, b) in self.slots.iter().zip(out.chunks_exact_mut(4)) {
+            let [c0, c1] = m.count.to_le_bytes();
+            b.copy_from_slice(&[m.flags_byte(), 0, c0, c1]);
+        }
+        out
+    }
+
+    /// The counts in `bytes` ([`Pending::encode`]); a slot naming no count is free.
+    pub fn decode(bytes: &[u8; PENDING_LEN]) -> Pending {
+        let mut p = Pending::EMPTY;
+        for (m, b) in p.slots.iter_mut().zip(bytes.chunks_exact(4)) {
+            if let [h1, _, c0, c1] = *b {
+                let what = usize::from(h1 & 0x0F);
+                let count = u16::from_le_bytes([c0, c1]);
+                if what < ResetKind::ALL.len() && count > 0 {
+                    *m = Mark {
+                        what,
+                        count,
+                        failed: h1 & MARK_FAILED != 0,
+                        safe_mode: h1 & MARK_SAFE_MODE != 0,
+                    };
+                }
+            }
+        }
+        p
+    }
+}
+
+/// The safe mode's boot counted in RAM (`pending`): its reset's kind, whether the run it
+/// follows failed, flagged safe mode. No flash is read or written (the safe mode does not
+/// depend on the log); the next boot that is not the safe mode's writes it
+/// ([`record_boot`]). `false` when every slot holds another count (this one is lost).
+pub fn count_safe_mode(pending: &mut Pending, boot: &BootRecord) -> bool {
+    pending.add(boot.kind, Entry::of(&boot.previous).is_some(), true)
 }
 
 mod pages;

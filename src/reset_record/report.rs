@@ -6,6 +6,9 @@
 
 use super::log::{Ended, Entry, Totals};
 use super::{PreviousRun, ResetCause, ResetKind, ResetRecord, ResetSource};
+use crate::clock::ClockSource;
+use crate::self_check::CheckId;
+use crate::startup::{BootFacts, SafeModeReason};
 
 /// Bytes of one line at most (longer text is cut).
 pub const LINE_LEN: usize = 192;
@@ -204,6 +207,17 @@ pub fn totals_line(t: &Totals) -> ReportLine {
     l
 }
 
+/// `reset log: N resets counted in RAM, not yet written` when `n` > 0 (the totals above
+/// include them; `log::Pending`).
+pub fn pending_line(n: u32) -> Option<ReportLine> {
+    let mut l = ReportLine::default();
+    l.push("reset log: ")
+        .number(n)
+        .push(" resets counted in RAM, not yet written")
+        .end();
+    (n > 0).then_some(l)
+}
+
 /// `head` and the `items`, comma separated (the self-check's findings: `self-check: did not
 /// take: RCC_CR.CSSON, FLASH_OPTR.BOR_LEV`); `None` without items.
 pub fn list_line<'a>(head: &str, items: impl Iterator<Item = &'a str>) -> Option<ReportLine> {
@@ -232,4 +246,48 @@ pub fn safe_mode_line(code: u8, why: &str) -> ReportLine {
         .push("; not monitoring; press the reset button to try again")
         .end();
     l
+}
+
+/// The report's first lines for a boot that found `facts` (firmware `version`): the boot
+/// line (the reset's source, the brown-out level, the clock), the previous run's end, the
+/// self-check's findings and the safe mode's line (the last two when there are any).
+pub fn head_lines(version: &str, facts: &BootFacts) -> [Option<ReportLine>; 4] {
+    let clock = match facts.clock {
+        Some(ClockSource::Hse) => "24 MHz crystal (HSE)",
+        Some(_) => "internal oscillator (HSI, +-1 %)",
+        None => "16 MHz reset clock (safe mode)",
+    };
+    let findings = list_line(
+        "self-check: did not take: ",
+        facts.findings.mismatched().map(CheckId::name),
+    );
+    let safe = facts.safe_mode.map(|reason| {
+        let why = match reason {
+            SafeModeReason::BootLoop { .. } => "boots in a row failed before the monitor was up",
+            SafeModeReason::PllDidNotLock => "the PLL did not lock",
+        };
+        safe_mode_line(reason.code(), why)
+    });
+    [
+        Some(boot_line(
+            version,
+            facts.reset_source,
+            facts.bor.status_number(),
+            clock,
+        )),
+        Some(previous_line(&facts.previous)),
+        findings,
+        safe,
+    ]
+}
+
+/// The safe mode's report (`facts.safe_mode` set): [`head_lines`], then a line saying the
+/// reset log in flash is neither read nor written: the safe mode touches no flash, so a
+/// fault in the log's scan (what it would escape) cannot follow it there.
+pub fn safe_mode_report(version: &str, facts: &BootFacts) -> [Option<ReportLine>; 5] {
+    let [a, b, c, d] = head_lines(version, facts);
+    let mut log = ReportLine::default();
+    log.push("reset log: not read in the safe mode (this boot is counted in RAM, written by the next run)")
+        .end();
+    [a, b, c, d, Some(log)]
 }

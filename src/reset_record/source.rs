@@ -62,6 +62,22 @@ impl ResetSource {
             ResetSource::Unknown => "unknown",
         }
     }
+
+    /// Whether the firmware caused the reset: a watchdog (the firmware stopped petting
+    /// it), a software reset (the fault path's, the set-up deadline's), an illegal
+    /// low-power entry. A power-on, a brown-out, the reset button (or a debugger's reset
+    /// through NRST), an option-byte load and no flag at all are someone else's: the boot
+    /// block's count of failed boots in a row starts again after them
+    /// (`crate::boot_block::BootHistory::of`).
+    pub const fn caused_by_firmware(self) -> bool {
+        matches!(
+            self,
+            ResetSource::IndependentWatchdog
+                | ResetSource::WindowWatchdog
+                | ResetSource::Software
+                | ResetSource::LowPower
+        )
+    }
 }
 
 /// What reset the MCU, as the reset log counts it: the reset flags' source

@@ -72,11 +72,16 @@ pub enum CheckId {
     /// `ADC12_CCR`: `PRESC` = 0010 (/4, 42.5 MHz), `CKMODE` = 00, `DUAL` = 00000
     /// (independent), `VREFEN` on.
     AdcCommon = 15,
+    /// `FLASH_OPTR.nSWBOOT0` (bit 26) = 0: the option bit `nBOOT0` chooses the boot memory,
+    /// not the BOOT0 pin (PB8). At the factory's 1 the pin decides and `nBOOT0` has no
+    /// effect: a pin high at a reset starts ST's bootloader instead of the firmware. (Bit 18
+    /// of the findings: 16 and 17 are the clock's.)
+    BootPinIgnored = 18,
 }
 
 impl CheckId {
     /// Every check, in the order of their bits.
-    pub const ALL: [CheckId; 16] = [
+    pub const ALL: [CheckId; 17] = [
         CheckId::FreezeWatchdog,
         CheckId::FreezeTimers,
         CheckId::ClockSecurity,
@@ -93,10 +98,11 @@ impl CheckId {
         CheckId::EncoderEnables,
         CheckId::LatchDma,
         CheckId::AdcCommon,
+        CheckId::BootPinIgnored,
     ];
     /// The checks read right after the clock set-up (the freeze, the clock security
     /// system, the option bytes).
-    pub const BOOT: [CheckId; 10] = [
+    pub const BOOT: [CheckId; 11] = [
         CheckId::FreezeWatchdog,
         CheckId::FreezeTimers,
         CheckId::ClockSecurity,
@@ -107,6 +113,7 @@ impl CheckId {
         CheckId::BootBank1,
         CheckId::DualBank,
         CheckId::BrownOutLevel,
+        CheckId::BootPinIgnored,
     ];
     /// The checks read once the acquisition runs (the encoder's timer, the ADCs' common
     /// register).
@@ -143,6 +150,7 @@ impl CheckId {
             CheckId::EncoderEnables => "TIM4_CCER.CC1E/CC1P/CC2E/CC2P/CC3E/CC3P",
             CheckId::LatchDma => "TIM4_DIER.CC3DE",
             CheckId::AdcCommon => "ADC12_CCR.PRESC/CKMODE/DUAL/VREFEN",
+            CheckId::BootPinIgnored => "FLASH_OPTR.nSWBOOT0",
         }
     }
 }
@@ -186,6 +194,8 @@ pub const OPTR_SRAM_PE: u32 = 1 << 24;
 pub const OPTR_CCMSRAM_RST: u32 = 1 << 25;
 /// `FLASH_OPTR.nBOOT0`.
 pub const OPTR_NBOOT0: u32 = 1 << 27;
+/// `FLASH_OPTR.nSWBOOT0`.
+pub const OPTR_NSWBOOT0: u32 = 1 << 26;
 
 /// What the expected values depend on: the run's clock source, the motor record's encoder
 /// set-up (`None`: not known, as for `cargo fw bring-up`, which then leaves those bits out
@@ -224,6 +234,7 @@ impl Expectation {
             CheckId::CcmSramKept => (FLASH_OPTR, OPTR_CCMSRAM_RST, OPTR_CCMSRAM_RST),
             CheckId::SramParityOff => (FLASH_OPTR, OPTR_SRAM_PE, OPTR_SRAM_PE),
             CheckId::BootFromFlash => (FLASH_OPTR, OPTR_NBOOT0, OPTR_NBOOT0),
+            CheckId::BootPinIgnored => (FLASH_OPTR, OPTR_NSWBOOT0, 0),
             CheckId::WatchdogBySoftware => (FLASH_OPTR, OPTR_IWDG_SW, OPTR_IWDG_SW),
             CheckId::BootBank1 => (FLASH_OPTR, OPTR_BFB2, 0),
             CheckId::DualBank => (FLASH_OPTR, OPTR_DBANK, OPTR_DBANK),

@@ -18,8 +18,9 @@ pub const DBGMCU_APB2FZR: u32 = 0xE004_2010;
 pub const RCC_CR: u32 = 0x4002_1000;
 pub const FLASH_OPTR: u32 = 0x4002_2020;
 pub const CSSON: u32 = 1 << 19;
-/// The factory option bytes with the brown-out level at 4 (what the firmware wants).
-pub const OPTR_GOOD: u32 = 0xFFEF_F8AA | (4 << 8);
+/// The factory option bytes with the brown-out level at 4 and `nSWBOOT0` (bit 26) at 0
+/// (what the firmware wants, what `cargo fw bor` writes).
+pub const OPTR_GOOD: u32 = (0xFFEF_F8AA | (4 << 8)) & !(1 << 26);
 /// `RCC_CSR`'s flags.
 pub const IWDGRSTF: u32 = 1 << 29;
 pub const PINRSTF: u32 = 1 << 26;

@@ -6,7 +6,7 @@ use super::boot;
 use super::model::{Board, BORRSTF, IWDGRSTF, PINRSTF};
 use drive_monitor::boot_block::{BootBlock, ResetKind, SAFE_MODE_AFTER};
 use drive_monitor::panel::{read_blink_code, PanelLamps};
-use drive_monitor::reset_record::PreviousRun;
+use drive_monitor::reset_record::{PreviousRun, ResetRecord};
 use drive_monitor::startup::{BootNote, SafeModeReason};
 
 /// The run after each boot hangs before it is up (the watchdog resets the MCU).
@@ -102,4 +102,34 @@ fn the_safe_mode_blinks_its_code() {
         SafeModeReason::BootLoop { failed_boots: 5 }.code(),
         SafeModeReason::PllDidNotLock.code()
     );
+}
+
+/// Four failed boots, then a run whose sample path stalls: its record is written, and the
+/// reset button is pressed before the watchdog's reset. The boot reports the stall and the
+/// reset (`ResetDuring`) but starts the count again (a person is at the board); the same
+/// run ended by the watchdog is the fifth failed boot and the safe mode follows. A power-on
+/// (RAM lost) ends the safe mode too.
+#[test]
+fn a_button_press_after_a_stall_starts_the_count_again() {
+    let mut board = Board::power_on();
+    for _ in 0..4 {
+        boot(&mut board);
+        board = board.reset(IWDGRSTF);
+    }
+    assert_eq!(boot(&mut board).history.failed_boots, 4);
+    board.reset_ram = ResetRecord::sample_stall(300).encode();
+    let mut pressed = board.reset(PINRSTF);
+    let facts = boot(&mut pressed);
+    assert!(matches!(facts.previous, PreviousRun::ResetDuring { .. }));
+    assert_eq!((facts.history.failed_boots, facts.safe_mode), (0, None));
+    let mut by_watchdog = board.reset(IWDGRSTF);
+    let facts = boot(&mut by_watchdog);
+    assert_eq!(facts.history.failed_boots, SAFE_MODE_AFTER);
+    assert!(facts.safe_mode.is_some());
+    // The safe mode, then a power cycle: RAM lost, a normal boot.
+    let mut cycled = Board::power_on();
+    cycled.regs = by_watchdog.regs.clone();
+    let facts = boot(&mut cycled);
+    assert_eq!((facts.history.failed_boots, facts.safe_mode), (0, None));
+    assert_eq!(facts.history.kind, ResetKind::PowerOn);
 }

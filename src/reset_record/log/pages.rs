@@ -3,8 +3,8 @@
 //! page in turn, and what a boot writes.
 
 use super::{
-    Entry, LogFlash, Mark, Totals, ENTRY_LEN, FULL_ENTRIES, HEADER_LEN, MARK_LEN, PAGES, PAGE_LEN,
-    UP,
+    Entry, LogFlash, Mark, Pending, Totals, ENTRY_LEN, FLUSH_AFTER, FULL_ENTRIES, HEADER_LEN,
+    MARK_LEN, PAGES, PAGE_LEN, PENDING_SLOTS, UP,
 };
 use crate::reset_record::{PreviousRun, ResetKind, ResetSource};
 
@@ -81,11 +81,23 @@ fn read_until_error<F: LogFlash>(flash: &mut F, page: usize, bytes: &mut [u8; PA
     at
 }
 
-/// The page in use (the valid header with the highest sequence number) and its scan.
+/// The sequence number in page `page`'s header (`None`: the header is not valid, or its
+/// read failed).
+fn header_seq<F: LogFlash>(flash: &mut F, page: usize) -> Option<u32> {
+    let mut header = [0u8; HEADER_LEN];
+    flash.read(page, 0, &mut header).ok()?;
+    Totals::decode_header(&header).map(|(seq, _)| seq)
+}
+
+/// The page in use (the valid header with the highest sequence number) and its scan: every
+/// page's header read, then the one page scanned (a boot reads 16 headers and one page, not
+/// the 16 pages).
 fn locate<F: LogFlash>(flash: &mut F) -> Option<(usize, PageScan)> {
-    (0..PAGES)
-        .filter_map(|page| scan(flash, page, |_| {}).map(|s| (page, s)))
-        .max_by_key(|(_, s)| s.seq)
+    let page = (0..PAGES)
+        .filter_map(|page| header_seq(flash, page).map(|seq| (page, seq)))
+        .max_by_key(|(_, seq)| *seq)?
+        .0;
+    scan(flash, page, |_| {}).map(|s| (page, s))
 }
 
 /// Appends `item` to the log whose page in use is `at` ([`locate`]): after its last item,
@@ -121,29 +133,80 @@ pub struct BootRecord {
     pub kind: ResetKind,
     /// The previous run was up for 10 minutes: the "up" mark first.
     pub previous_long_up: bool,
+    /// The previous run was up (10 s of samples): the counts in RAM are written now.
+    pub previous_up: bool,
+    /// RAM survived the reset (the boot block was valid): counts can wait there. `false`
+    /// (a power-on): this boot's count is written now, RAM keeps nothing.
+    pub ram_kept: bool,
     /// This boot enters the safe mode.
     pub safe_mode: bool,
 }
 
-/// What [`record_boot`] wrote.
+/// What [`record_boot`] did with the boot's item.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Written {
     /// A full entry, its sequence number.
     Entry(u32),
-    /// A count mark; `failed`: a failed run beyond the rate limit.
+    /// A count mark, written with the counts that waited in RAM; `failed`: a failed run
+    /// beyond the rate limit.
     Counted {
+        /// The run counted had failed.
+        failed: bool,
+    },
+    /// A count kept in RAM ([`Pending`]), not written yet.
+    Pending {
         /// The run counted had failed.
         failed: bool,
     },
 }
 
-/// Writes the boot's item (module docs of `reset_record::log`): the "up" mark when the
-/// previous run was long up, then a full entry for a failed run within the rate limit
-/// ([`FULL_ENTRIES`] since the last "up"), else a count mark of the reset's kind.
+/// Writes the counts in RAM (`pending`), one mark a slot, as one item in the log whose page
+/// in use is `at` ([`locate`]); empties them once written.
+fn flush<F: LogFlash>(
+    flash: &mut F,
+    at: Option<(usize, PageScan)>,
+    pending: &mut Pending,
+) -> Result<(), F::Error> {
+    let mut bytes = [0u8; MARK_LEN * PENDING_SLOTS];
+    let mut len = 0;
+    for (m, out) in pending.marks().zip(bytes.chunks_exact_mut(MARK_LEN)) {
+        out.copy_from_slice(&m.encode());
+        len += MARK_LEN;
+    }
+    if len > 0 {
+        append(flash, at, bytes.get(..len).unwrap_or(&[]))?;
+    }
+    *pending = Pending::EMPTY;
+    Ok(())
+}
+
+/// The boot's item (module docs of `reset_record::log`): the "up" mark when the previous
+/// run was long up, a full entry for a failed run within the rate limit ([`FULL_ENTRIES`]
+/// since the last "up"), else a count of the reset's kind, added to the counts in RAM
+/// (`pending`). Those are written, one mark a slot, when the write is due: after a power-on
+/// (RAM kept nothing), after a run that was up (10 s of samples: at most one write every
+/// 10 s), after the safe mode, when [`FLUSH_AFTER`] boots are counted, or when the slots are
+/// full. A clean boot with nothing due reads no flash at all.
 ///
 /// # Errors
-/// The flash's error when an erase or a write failed (or was refused).
-pub fn record_boot<F: LogFlash>(flash: &mut F, boot: &BootRecord) -> Result<Written, F::Error> {
+/// The flash's error when an erase or a write failed (or was refused); the counts stay in
+/// `pending`.
+pub fn record_boot<F: LogFlash>(
+    flash: &mut F,
+    boot: &BootRecord,
+    pending: &mut Pending,
+) -> Result<Written, F::Error> {
+    let ended = Entry::of(&boot.previous);
+    let failed = ended.is_some();
+    let due =
+        !boot.ram_kept || boot.previous_up || boot.previous_long_up || pending.holds_safe_mode();
+    let mut counted = false;
+    if !failed && !due {
+        counted = pending.add(boot.kind, false, false);
+        if counted && pending.count() < FLUSH_AFTER {
+            return Ok(Written::Pending { failed: false });
+        }
+    }
     let mut at = locate(flash);
     if boot.previous_long_up {
         let up = Mark {
@@ -156,7 +219,7 @@ pub fn record_boot<F: LogFlash>(flash: &mut F, boot: &BootRecord) -> Result<Writ
         at = locate(flash);
     }
     let totals = at.map(|(_, s)| s.totals).unwrap_or_default();
-    match Entry::of(&boot.previous) {
+    match ended {
         Some((ended, record, phase)) if totals.entries_since_up < FULL_ENTRIES => {
             let entry = Entry {
                 seq: totals.last_entry.wrapping_add(1),
@@ -168,19 +231,25 @@ pub fn record_boot<F: LogFlash>(flash: &mut F, boot: &BootRecord) -> Result<Writ
                 record,
             };
             append(flash, at, &entry.encode())?;
+            if due {
+                let at = locate(flash);
+                flush(flash, at, pending)?;
+            }
             Ok(Written::Entry(entry.seq))
         }
-        end => {
-            let mark = Mark {
-                what: boot.kind.index(),
-                count: 1,
-                failed: end.is_some(),
-                safe_mode: boot.safe_mode,
-            };
-            append(flash, at, &mark.encode())?;
-            Ok(Written::Counted {
-                failed: mark.failed,
-            })
+        _ => {
+            if !counted && !pending.add(boot.kind, failed, boot.safe_mode) {
+                // Every slot holds another count: those first, then this one.
+                flush(flash, at, pending)?;
+                at = locate(flash);
+                pending.add(boot.kind, failed, boot.safe_mode);
+            }
+            if due || pending.count() >= FLUSH_AFTER {
+                flush(flash, at, pending)?;
+                Ok(Written::Counted { failed })
+            } else {
+                Ok(Written::Pending { failed })
+            }
         }
     }
 }

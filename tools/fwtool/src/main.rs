@@ -7,9 +7,10 @@
 //!   224 KiB; 32 KiB of static RAM), whether every allocated section lies in bank 1 (bank 2,
 //!   from 0x0804_0000, is the records' and the reset log's) and whether the stack lies below
 //!   the statics (flip-link). `--check` exits 1 when any of these is missed.
-//! - `fw bring-up [--no-flash]`: flash the firmware with probe-rs, reset, and read back over
-//!   the probe every register the boot's self-check reads, each against its expected value
-//!   (`bring_up`; the user installs probe-rs). Exits 1 on a mismatch.
+//! - `fw bring-up [--no-flash] [--dry-run]`: flash the firmware with probe-rs, reset, and
+//!   read back over the probe every register the boot's self-check reads, each against its
+//!   expected value, as a table (`bring_up`; the user installs probe-rs). Exits 1 on a
+//!   mismatch. `--dry-run` prints the commands and what each read should find.
 //! - `qemu-core`: build `crates/core-on-m4` for `thumbv7em-none-eabihf`, check that its
 //!   vector table is at 0x0 (the mps2-an386 layout, not the G474's), and run it on
 //!   `qemu-system-arm -M mps2-an386 -cpu cortex-m4 -icount shift=0` with semihosting.
@@ -19,8 +20,9 @@
 //!   sample may be lost); `--blocking` builds the control with defmt-rtt's blocking mode (the
 //!   samples must stop), `--drop-on-contention` defmt-rtt's other mode, for comparison.
 //!
-//! - `fw bor [--dry-run]`: program the brown-out reset level 4 (about 2.8 V) into the
-//!   option bytes of the board on the ST-LINK, once per board, with ST's
+//! - `fw bor [--dry-run]`: program the brown-out reset level 4 (about 2.8 V) and the boot
+//!   memory chosen by the option bit, not the BOOT0 pin (`nSWBOOT0` = 0, `nBOOT0` = 1), into
+//!   the option bytes of the board on the ST-LINK, once per board, with ST's
 //!   `STM32_Programmer_CLI` (which runs RM0440's option-byte sequence: unlock, write
 //!   `FLASH_OPTR`, `OPTSTRT`, `OBL_LAUNCH`), then read the option bytes back. The firmware
 //!   only reads the level and warns at every boot while it is below 4; writing option bytes
@@ -279,8 +281,20 @@ fn print_usage(
 }
 
 /// `fw bring-up` (`bring_up`): the firmware built, flashed (unless `--no-flash`) and its
-/// registers read back over the probe.
-fn fw_bring_up(no_flash: bool) -> Result<ExitCode, String> {
+/// registers read back over the probe; with `dry_run` only the commands and what each read
+/// should find, printed (nothing built, no probe).
+fn fw_bring_up(no_flash: bool, dry_run: bool) -> Result<ExitCode, String> {
+    if dry_run {
+        let root = root().canonicalize().unwrap_or_else(|_| root());
+        let elf = target_dir(&root)
+            .join(TARGET)
+            .join("firmware/drive-monitor");
+        println!("cargo build --profile firmware --target {TARGET} -p drive-monitor");
+        for line in bring_up::plan(&elf.to_string_lossy(), no_flash) {
+            println!("{line}");
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
     let elf = build_firmware()?;
     Ok(if bring_up::run(&elf, no_flash)? {
         ExitCode::SUCCESS
@@ -295,7 +309,8 @@ const ST_PROGRAMMER: &str = "STM32_Programmer_CLI";
 /// The brown-out level the firmware wants (`drive_monitor::supply::BOR_GOAL`).
 const BOR_LEVEL: u8 = 4;
 
-/// `fw bor`: programs `BOR_LEV` = [`BOR_LEVEL`] over SWD and reads the option bytes back;
+/// `fw bor`: programs `BOR_LEV` = [`BOR_LEVEL`], `nSWBOOT0` = 0 and `nBOOT0` = 1 over SWD
+/// and reads the option bytes back;
 /// with `dry_run` only prints the commands.
 fn bor(dry_run: bool) -> Result<(), String> {
     let program = [
@@ -303,12 +318,17 @@ fn bor(dry_run: bool) -> Result<(), String> {
         "port=SWD".into(),
         "-ob".into(),
         format!("BOR_LEV={BOR_LEVEL}"),
+        // The boot memory from the option bit nBOOT0 (1: the main flash), not from the
+        // BOOT0 pin (PB8): the factory's nSWBOOT0 = 1 lets a pin high at reset start ST's
+        // bootloader (the self-check's `FLASH_OPTR.nSWBOOT0`).
+        "nSWBOOT0=0".into(),
+        "nBOOT0=1".into(),
     ];
     let display = ["-c", "port=SWD", "-ob", "displ"];
     println!("{ST_PROGRAMMER} {}", program.join(" "));
     println!("{ST_PROGRAMMER} {}", display.join(" "));
     if dry_run {
-        println!("(dry run: nothing written; the next boot's log shows `brown-out reset level 4`)");
+        println!("(dry run: nothing written; the next boot's log shows `brown-out reset level 4` and no self-check finding for FLASH_OPTR.nSWBOOT0)");
         return Ok(());
     }
     run(Command::new(ST_PROGRAMMER).args(&program)).map_err(|e| {
@@ -415,13 +435,16 @@ fn main() -> ExitCode {
             bor(args.iter().any(|a| a == "--dry-run")).map(|()| ExitCode::SUCCESS)
         }
         Some("fw") if args.get(1).map(String::as_str) == Some("bring-up") => {
-            fw_bring_up(args.iter().any(|a| a == "--no-flash"))
+            fw_bring_up(
+                args.iter().any(|a| a == "--no-flash"),
+                args.iter().any(|a| a == "--dry-run"),
+            )
         }
         Some("fw") => fw(args.iter().any(|a| a == "--check")).map(|()| ExitCode::SUCCESS),
         Some("qemu-core") => qemu_core(),
         Some("qemu-rtt") => qemu_rtt(&args[1..]),
         _ => Err(
-            "usage: fwtool fw [--check] | fw bor [--dry-run] | fw bring-up [--no-flash] | qemu-core | qemu-rtt [--blocking | --drop-on-contention]"
+            "usage: fwtool fw [--check] | fw bor [--dry-run] | fw bring-up [--no-flash] [--dry-run] | qemu-core | qemu-rtt [--blocking | --drop-on-contention]"
                 .into(),
         ),
     };
