@@ -147,19 +147,18 @@ pub const RECORD_B_FLASH_OFFSET: u32 = MOTOR_RECORD_FLASH_OFFSET - RECORD_PAGE_S
 /// [`LOG_PAGES`] pages of 2 KiB) from the start of flash, bytes: the pages before the
 /// record's second, `0x0807_6800`..`0x0807_E800` for 16, bank 2 like the records.
 pub const RESET_LOG_FLASH_OFFSET: u32 = RECORD_B_FLASH_OFFSET - LOG_PAGES * RECORD_PAGE_SIZE;
-/// The reset log's pages (`reset_record::log::PAGES`, the one number both use).
-const LOG_PAGES: u32 = crate::reset_record::log::PAGES as u32;
+/// The reset log's pages of 2 KiB (`reset_record::log::PAGES` is this number: the flash
+/// map owns it, so the log's pages and the records' cannot disagree).
+pub const LOG_PAGES: u32 = 16;
 /// The start of bank 2 (dual-bank mode) from the start of flash, bytes: `0x0804_0000`.
 /// Everything from here on is data (the records, the reset log), never code.
 pub const BANK2_OFFSET: u32 = 0x0004_0000;
 // The reset log's pages end where the records begin (the commissioning record's second
 // page, then the motor record's, then the first), each page the records' size, all in bank 2:
-// raising `reset_record::log::PAGES` moves the log down, never over a record.
+// raising [`LOG_PAGES`] moves the log down, never over a record (`reset_record::log`
+// asserts that its pages are the records' size).
 const _: () = assert!(
-    RESET_LOG_FLASH_OFFSET
-        + crate::reset_record::log::PAGES as u32 * crate::reset_record::log::PAGE_LEN as u32
-        == RECORD_B_FLASH_OFFSET
-        && crate::reset_record::log::PAGE_LEN as u32 == RECORD_PAGE_SIZE
+    RESET_LOG_FLASH_OFFSET + LOG_PAGES * RECORD_PAGE_SIZE == RECORD_B_FLASH_OFFSET
         && RECORD_B_FLASH_OFFSET + RECORD_PAGE_SIZE == MOTOR_RECORD_FLASH_OFFSET
         && MOTOR_RECORD_FLASH_OFFSET + RECORD_PAGE_SIZE == RECORD_FLASH_OFFSET
         && RESET_LOG_FLASH_OFFSET >= BANK2_OFFSET,

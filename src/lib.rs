@@ -84,6 +84,7 @@ pub mod app;
 pub mod board;
 pub mod boot;
 pub mod boot_block;
+pub mod boot_report;
 pub mod clip_watch;
 pub mod clock;
 pub mod commissioning;

@@ -3,7 +3,7 @@
 //! (the PAC embassy-stm32 0.6 is built on, `stm32-metapac` 21 with `stm32g474re`).
 //!
 //! The blocks are not taken at their fixed addresses but through a [`Bus`]: on the board
-//! [`Direct`] hands back the MCU's own address (`MCU`, what `src/firmware/*` calls), in the
+//! [`McuBus`] hands back the MCU's own address (`MCU`, what `src/firmware/*` calls), in the
 //! host tests (`tests/registers.rs`) a memory of the test's own stands behind every
 //! peripheral, and the test reads back word by word, at RM0440's addresses and bits written
 //! out there, what each method wrote, and answers each read. So a wrong register, bit or
@@ -44,12 +44,12 @@ pub unsafe trait Bus: Copy {
 
 /// The MCU's own addresses: the bus on the board.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Direct;
+pub struct McuBus;
 
 // SAFETY: on the STM32G474 the peripherals' base addresses are the peripherals (RM0440,
 // "Memory map"); the layer only ever asks for those.
 #[allow(unsafe_code)]
-unsafe impl Bus for Direct {
+unsafe impl Bus for McuBus {
     #[inline(always)]
     fn at(self, address: usize) -> *mut () {
         address as *mut ()
@@ -63,7 +63,7 @@ pub struct Registers<B: Bus> {
 }
 
 /// The layer on the board's own registers.
-pub const MCU: Registers<Direct> = Registers::new(Direct);
+pub const MCU: Registers<McuBus> = Registers::new(McuBus);
 
 /// A peripheral block of type `$ty` on the bus, at the address of stm32-metapac's `$pac`.
 macro_rules! block {

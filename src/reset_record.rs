@@ -574,7 +574,7 @@ impl PreviousRun {
 }
 
 pub mod log;
-pub mod report;
+
 mod source;
 pub use source::{ResetKind, ResetSource};
 #[cfg(test)]

@@ -265,8 +265,8 @@ fn the_long_up_mark_gives_the_logs_entries_back() {
 /// reaches no flash: a fault in the log's scan cannot follow the board into the safe mode.
 #[test]
 fn the_safe_mode_does_not_depend_on_the_logs_scan() {
+    use drive_monitor::boot_report as report;
     use drive_monitor::clock::ClockSource;
-    use drive_monitor::reset_record::report;
     use drive_monitor::self_check::Findings;
     use drive_monitor::startup::{BootFacts, SafeModeReason};
     use drive_monitor::supply::BorCheck;

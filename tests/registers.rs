@@ -774,11 +774,21 @@ fn the_ram_start_is_the_memory_maps() {
     assert_eq!(origin, 0x2000_0000);
 }
 
-/// On the board the bus is the MCU's own addresses: `Direct` hands back each address as it
+/// On the board the bus is the MCU's own addresses: `McuBus` hands back each address as it
 /// is (not dereferenced here), so `MCU`'s blocks are the peripherals RM0440 places there.
 #[test]
 fn the_boards_bus_is_the_mcus_own_addresses() {
-    for address in [RCC, FLASH, DMA1, TIM4, ADC1, ADC12_COMMON, GPIOB, DBGMCU, IWDG] {
-        assert_eq!(regs::Direct.at(address as usize) as usize, address as usize);
+    for address in [
+        RCC,
+        FLASH,
+        DMA1,
+        TIM4,
+        ADC1,
+        ADC12_COMMON,
+        GPIOB,
+        DBGMCU,
+        IWDG,
+    ] {
+        assert_eq!(regs::McuBus.at(address as usize) as usize, address as usize);
     }
 }

@@ -1,14 +1,14 @@
 //! The reset log in flash (`drive_monitor::reset_record::log`) and the boot report on the
-//! virtual COM port (`reset_record::report`): every reset counted, the ends of failed runs
+//! virtual COM port (`boot_report`): every reset counted, the ends of failed runs
 //! kept across a power loss and a torn write, the rate limit that bounds the wear to more
 //! than a year of a boot every second, and the text a technician reads without a probe.
 
+use drive_monitor::boot_report::{
+    boot_line, entry_line, list_line, previous_line, safe_mode_line, totals_line,
+};
 use drive_monitor::reset_record::log::{
     self, BootRecord, Ended, Entry, LogFlash, Pending, Written, ENTRY_LEN, FLUSH_AFTER,
     FULL_ENTRIES, MARKS_PER_PAGE, PAGES, PAGE_LEN, PENDING_SLOTS,
-};
-use drive_monitor::reset_record::report::{
-    boot_line, entry_line, list_line, previous_line, safe_mode_line, totals_line,
 };
 use drive_monitor::reset_record::{BootPhase, PreviousRun, ResetKind, ResetRecord, ResetSource};
 
@@ -551,8 +551,8 @@ fn the_report_says_what_waits_in_ram() {
     );
 }
 
-fn log_report_pending(n: u32) -> Option<drive_monitor::reset_record::report::ReportLine> {
-    drive_monitor::reset_record::report::pending_line(n)
+fn log_report_pending(n: u32) -> Option<drive_monitor::boot_report::ReportLine> {
+    drive_monitor::boot_report::pending_line(n)
 }
 
 /// The log's 16 pages sit where memory.x and docs/firmware.md say, 0x0807_6800..0x0807_E800,

@@ -151,7 +151,12 @@ fn explains_text_reads_like_its_verdict() {
         let listed = if of("no_effect").contains(bad) {
             // The line and its wrapped continuation.
             std::iter::once(lines[none])
-                .chain(lines[none + 1..].iter().copied().take_while(|l| l.starts_with("      ")))
+                .chain(
+                    lines[none + 1..]
+                        .iter()
+                        .copied()
+                        .take_while(|l| l.starts_with("      ")),
+                )
                 .any(|l| l.contains(bad.as_str()))
         } else {
             lines[implausible..]

@@ -26,9 +26,9 @@ static GUARD: FaultGuard = FaultGuard::new();
 pub(super) static ECC: EccLatch = EccLatch::new();
 
 /// The fault path's board: the reset record's RAM, `FLASH_OPTR` and the lamp pins.
-struct Registers;
+struct FaultHardware;
 
-impl FaultBoard for Registers {
+impl FaultBoard for FaultHardware {
     fn bor_level(&mut self) -> Option<BorLevel> {
         bor_level()
     }
@@ -69,7 +69,7 @@ unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
     let regs = fault_registers(frame.pc(), frame.lr());
     end(fault_path::on_hard_fault(
         &GUARD,
-        &mut Registers,
+        &mut FaultHardware,
         None,
         regs,
     ))
@@ -95,7 +95,7 @@ unsafe fn NonMaskableInt() {
             cortex_m::interrupt::disable();
             end(fault_path::on_fault(
                 &GUARD,
-                &mut Registers,
+                &mut FaultHardware,
                 ResetRecord::clock_failure(),
             ))
         }
@@ -108,7 +108,7 @@ unsafe fn NonMaskableInt() {
             let lr = cortex_m::register::lr::read();
             end(fault_path::on_hard_fault(
                 &GUARD,
-                &mut Registers,
+                &mut FaultHardware,
                 Some(-14),
                 fault_registers(0, lr),
             ))
@@ -125,7 +125,7 @@ unsafe fn DefaultHandler(irqn: i16) {
     let regs = fault_registers(0, cortex_m::register::lr::read());
     end(fault_path::on_hard_fault(
         &GUARD,
-        &mut Registers,
+        &mut FaultHardware,
         Some(irqn),
         regs,
     ))
@@ -139,7 +139,7 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     cortex_m::interrupt::disable();
     let location = info.location().map(|l| (l.file(), l.line()));
     let record = ResetRecord::on_panic(info.message().as_str(), location);
-    end(fault_path::on_fault(&GUARD, &mut Registers, record))
+    end(fault_path::on_fault(&GUARD, &mut FaultHardware, record))
 }
 
 /// A panic through `defmt::panic!` (the HAL with its `defmt` feature, `defmt::unwrap!`):
@@ -152,7 +152,7 @@ fn defmt_panic() -> ! {
     let return_address = cortex_m::register::lr::read();
     let phase = BootPhase::from_number(PHASE.load(Ordering::Relaxed)).unwrap_or(BootPhase::Boot);
     let record = ResetRecord::defmt_panic(phase, return_address);
-    end(fault_path::on_fault(&GUARD, &mut Registers, record))
+    end(fault_path::on_fault(&GUARD, &mut FaultHardware, record))
 }
 
 /// The reset after the fault path: at once for a fault inside it (the first record

@@ -1,9 +1,10 @@
 //! The boot report on the ST-LINK's virtual COM port (USART2 TX on PA2, 115 200 8N1) and the
-//! reset log in flash (`drive_monitor::reset_record::{log, report}`): what a technician
+//! reset log in flash (`drive_monitor::reset_record::log`, `drive_monitor::boot_report`): what a technician
 //! reads without a probe.
 
 use defmt::error;
-use drive_monitor::reset_record::{log, report};
+use drive_monitor::boot_report as report;
+use drive_monitor::reset_record::log;
 use drive_monitor::startup::BootFacts;
 use embassy_stm32::usart::{Config as UsartConfig, UartTx};
 use embassy_stm32::{peripherals, Peri};
@@ -17,7 +18,7 @@ use super::{logs, reset_ram};
 /// before sampling starts, so an erase holds nothing up),
 /// then the boot report, the self-check's findings, the safe mode, the log's counts and its
 /// four newest entries as text on the ST-LINK's virtual COM port (USART2 TX on PA2,
-/// 115 200 8N1; `drive_monitor::reset_record::report`).
+/// 115 200 8N1; `drive_monitor::boot_report`).
 pub(super) fn report_boot(
     flash: &mut BoardFlash,
     (usart, tx): (

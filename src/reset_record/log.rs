@@ -53,8 +53,13 @@ pub const MARK_LEN: usize = 8;
 pub const HEADER_LEN: usize = 64;
 /// Bytes of a log page (the G4's page in dual-bank mode).
 pub const PAGE_LEN: usize = 2048;
-/// Pages of the log.
-pub const PAGES: usize = 16;
+/// Pages of the log (`board::LOG_PAGES`, where the flash map places them).
+pub const PAGES: usize = crate::board::LOG_PAGES as usize;
+// A log page is a record page: the log's pages end where the records begin (`board`).
+const _: () = assert!(
+    PAGE_LEN as u32 == crate::board::RECORD_PAGE_SIZE,
+    "a reset log page must be the records' page size"
+);
 /// Count marks a page holds.
 pub const MARKS_PER_PAGE: usize = (PAGE_LEN - HEADER_LEN) / MARK_LEN;
 /// Full entries a page holds.

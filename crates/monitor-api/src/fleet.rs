@@ -350,13 +350,7 @@ impl FleetRow {
             phase,
             confidence,
             first_detection_s: r.first_detection_s,
-            load_moves: Some(
-                r.isolation
-                    .events
-                    .iter()
-                    .filter(|e| matches!(e, IsolationEvent::LoadMoved { .. }))
-                    .count() as u64,
-            ),
+            load_moves: Some(load_moves(r)),
             data_quality: Some(r.data_quality.summary()),
             turns_low: turns.map(|t| short(t.low)),
             turns_high: turns.map(|t| short(t.high)),
@@ -379,6 +373,15 @@ impl FleetRow {
             error: None,
         }
     }
+}
+
+/// The load moves the isolation saw in `r`.
+fn load_moves(r: &DiagnoseReport) -> u64 {
+    r.isolation
+        .events
+        .iter()
+        .filter(|e| matches!(e, IsolationEvent::LoadMoved { .. }))
+        .count() as u64
 }
 
 /// The row of one log: its motor from `table`, diagnosed with that motor's file, window,

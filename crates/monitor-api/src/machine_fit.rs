@@ -1,5 +1,5 @@
 //! The full-order machine fitted to a log's first seconds against its parameter file, for
-//! `diagnose` where nothing is commissioned (`monitor_replay::MachineFit`): the residuals
+//! `diagnose` where nothing is commissioned (`monitor_replay::StartFit`): the residuals
 //! against the file's nominal values cannot tell a fault present from the first sample
 //! from the file's own error, a start or a load change in the log can. The fit is
 //! `identify`'s (`monitor_analysis::identify`), on at most [`FIT_WINDOW_S`] of the log.
@@ -7,7 +7,7 @@
 use monitor_analysis::identify::{identify, Samples};
 use monitor_io::log::{LogFile, Row, RowSink};
 use monitor_io::params::ParamFile;
-use monitor_replay::{FitParameter, FittedChange, MachineFit};
+use monitor_replay::{FitParameter, FittedChange, StartFit};
 
 /// The most of the log's start the machine is fitted to [s]: a direct-on-line start and
 /// its settling, or a load step after it, for the machines the project ships (a 37 kW
@@ -75,7 +75,7 @@ fn moves(rows: &[Row]) -> bool {
 /// The machine of `params` fitted to the head of `file`, where the log has its voltages
 /// and the fit runs (a log that leaves every parameter flat identifies none of them; a
 /// log the model cannot be driven by gives `None`).
-pub(crate) fn fit(params: &ParamFile, file: &LogFile) -> Option<MachineFit> {
+pub(crate) fn fit(params: &ParamFile, file: &LogFile) -> Option<StartFit> {
     let channels = file.channels();
     if !channels.voltages {
         return None;
@@ -111,7 +111,7 @@ pub(crate) fn fit(params: &ParamFile, file: &LogFile) -> Option<MachineFit> {
             })
         })
         .collect();
-    Some(MachineFit {
+    Some(StartFit {
         from_s: id.window_s.0,
         to_s: id.window_s.1,
         relative_rms_error: id.relative_rms_error,

@@ -83,7 +83,9 @@ pub enum LawProblem {
     #[error("it has no name (name = \"...\")")]
     NoName,
     /// A name a command line cannot give back (a comma), or empty.
-    #[error("the name may not be empty or hold a comma (--effects lists names with commas)")]
+    #[error(
+        "the name may not be empty or hold a comma (a list of effects separates names with commas)"
+    )]
     BadName,
     /// A library effect's name.
     #[error("'{0}' is the name of a library effect; give the law a name of its own")]

@@ -90,7 +90,7 @@ pub fn diagnose_log(
 /// [`diagnose_log`] with the full-order machine fitted to the log against the parameter
 /// file (`fit`, where the caller ran one: `monitor_api`'s, from `identify`), which the
 /// parameter fit's finding reads where nothing was commissioned
-/// ([`crate::MachineFit::finding`]).
+/// ([`crate::verdict::machine_fit::StartFit::finding`]).
 ///
 /// # Errors
 /// As [`diagnose_file`].
@@ -98,7 +98,7 @@ pub fn diagnose_log_fitted(
     params: &ParamFile,
     file: &LogFile,
     opts: ReplayOptions,
-    fit: Option<crate::MachineFit>,
+    fit: Option<crate::verdict::machine_fit::StartFit>,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Diagnosed, ReplayError> {
     let mut bar = Forward::new(progress);
@@ -180,7 +180,7 @@ fn replay_observed<'a>(
     shown: &str,
     opts: ReplayOptions,
     observer: Option<&'a mut dyn ReplayObserver>,
-    fit: Option<crate::MachineFit>,
+    fit: Option<crate::verdict::machine_fit::StartFit>,
     feed: impl FnOnce(&mut dyn RowSink) -> Result<(), LogError>,
 ) -> Result<Diagnosed, ReplayError> {
     match observer {
@@ -234,7 +234,7 @@ fn conclude(
     (read, quality): (Result<(), LogError>, Result<DataQuality, LogError>),
     shown: &str,
     opts: ReplayOptions,
-    fit: Option<crate::MachineFit>,
+    fit: Option<crate::verdict::machine_fit::StartFit>,
 ) -> Result<Diagnosed, ReplayError> {
     read?;
     let mut quality = quality?;
@@ -263,7 +263,10 @@ fn conclude(
         .monitor()
         .map_or_else(SensorFlags::default, |m| m.output().sensor_fault);
     let mut report = replay.end();
-    if let Some(f) = fit.as_ref().and_then(crate::MachineFit::finding) {
+    if let Some(f) = fit
+        .as_ref()
+        .and_then(crate::verdict::machine_fit::StartFit::finding)
+    {
         report.put_machine_fit(f);
     }
     describe_actions(&mut quality, can_residuals, handled);

@@ -99,7 +99,7 @@ pub use fields::{
     field_given, OptionError, OptionField, OptionSpec, OptionValue, Takes, DIAGNOSE_OPTIONS,
 };
 pub use timeline::{MonitorState, MovedWhy, Panel, TimelinePoint};
-pub use verdict::machine_fit::{FitParameter, FittedChange, MachineFit};
+pub use verdict::machine_fit::{FitParameter, FittedChange, StartFit};
 pub use verdict::{Detail, FileMisfit, FindingReport, Rule, SkippedAnalysis, Verdict};
 pub use winding::level::{LabelledRun, LevelBasis, ShortedTurns, TurnCalibration, TurnReach};
 pub use winding::{

@@ -163,7 +163,7 @@ impl DiagnoseReport {
     }
 
     /// The parameter fit's finding from the machine fitted to the log (`f`,
-    /// [`crate::MachineFit::finding`]), where the residuals were judged against the file:
+    /// [`crate::verdict::machine_fit::StartFit::finding`]), where the residuals were judged against the file:
     /// a fault it names replaces the residuals' parameter-fit finding; the machine on the
     /// file replaces only a clear one (a misfit the residuals saw stands).
     pub(crate) fn put_machine_fit(&mut self, f: FindingReport) {

@@ -341,57 +341,11 @@ impl MachineBuilder<'_> {
         let m = self.m;
         let model = m.model::<f64>();
         let rs = m.rs_ohm * md.rs * md.th_s * md.law_s;
-        let rr = m.rr_ohm * md.rr * md.th_r * md.law_r;
-        let gamma_s = model.lls_h() <= 1e-9 * m.lm_h;
-        let gamma_r = model.llr_h() <= 1e-9 * m.lm_h;
-        let mut lm = m.lm_h
-            * if self.eff.lm0_over_file > 0.0 {
-                self.eff.lm0_over_file
-            } else {
-                1.0
-            };
-        if gamma_s {
-            lm *= md.lls;
-        }
-        if gamma_r {
-            lm *= md.llr;
-        }
-        let mut lls = if gamma_s { 0.0 } else { model.lls_h() * md.lls };
-        let mut llr = if gamma_r { 0.0 } else { model.llr_h() * md.llr };
-        let mut rr = rr;
-        if matches!(self.eff.mag_law, Some(MagLaw::Curve(_))) {
-            // A no-load curve is the stator inductance of the stator flux: the machine as
-            // its Gamma circuit (no stator leakage; the rotor leakage
-            // Ls (Ls Lr / Lm^2 - 1) and the rotor resistance Rr (Ls/Lm)^2 keep its
-            // terminal behaviour), Lm the curve's Ls.
-            let (ls, lr) = (lls + lm, llr + lm);
-            llr = ls * (ls * lr / (lm * lm) - 1.0);
-            rr *= (ls / lm).powi(2);
-            lls = 0.0;
-            lm = ls;
-        }
+        let (lls, llr, rr, lm) = self.circuit(md);
         // The fault resistance defaults to a tenth of the healthy phase's (cold) Rs.
         let turn = self.eff.asym.filter(|a| a.1 > 0.0).map(|(ph, mu, rf)| {
             TurnLoop::new(ph, mu, rf.unwrap_or(0.1 * m.rs_ohm), rs, model.lls_h())
         });
-        let (c_nm, w0) = self.eff.coulomb.unwrap_or((0.0, 1.0));
-        let load = if self.torque_load {
-            LoadLaw {
-                bl_nms: 0.0,
-                torque_nm: md.torque_nm * md.bl,
-                coulomb_nm: c_nm,
-                inv_w0: 1.0 / w0,
-                windage: self.eff.windage,
-            }
-        } else {
-            LoadLaw {
-                bl_nms: self.bl_base * md.bl_scale * md.bl,
-                torque_nm: 0.0,
-                coulomb_nm: c_nm,
-                inv_w0: 1.0 / w0,
-                windage: self.eff.windage,
-            }
-        };
         let mut machine = Machine::new(
             rs,
             turn,
@@ -407,11 +361,66 @@ impl MachineBuilder<'_> {
             model.np(),
             m.j_kgm2,
             m.b_nms * md.b,
-            load,
+            self.load_law(md),
         )?;
         machine.load_laws = Arc::clone(&self.eff.load_laws);
         machine.rr_asym = 2.0 / 3.0 * rr * self.eff.rotor_delta;
         Ok(machine)
+    }
+
+    /// The circuit's `(Lls, Llr, Rr, Lm)` [H, H, ohm, H] with the changes in effect: a
+    /// Gamma-form file's zero leakage scales Lm instead; a no-load curve makes the machine
+    /// its Gamma circuit (below).
+    fn circuit(&self, md: &ParameterScales) -> (f64, f64, f64, f64) {
+        let m = self.m;
+        let model = m.model::<f64>();
+        let rr = m.rr_ohm * md.rr * md.th_r * md.law_r;
+        let gamma_s = model.lls_h() <= 1e-9 * m.lm_h;
+        let gamma_r = model.llr_h() <= 1e-9 * m.lm_h;
+        let mut lm = m.lm_h
+            * if self.eff.lm0_over_file > 0.0 {
+                self.eff.lm0_over_file
+            } else {
+                1.0
+            };
+        if gamma_s {
+            lm *= md.lls;
+        }
+        if gamma_r {
+            lm *= md.llr;
+        }
+        let lls = if gamma_s { 0.0 } else { model.lls_h() * md.lls };
+        let llr = if gamma_r { 0.0 } else { model.llr_h() * md.llr };
+        if !matches!(self.eff.mag_law, Some(MagLaw::Curve(_))) {
+            return (lls, llr, rr, lm);
+        }
+        // A no-load curve is the stator inductance of the stator flux: the machine as its
+        // Gamma circuit (no stator leakage; the rotor leakage Ls (Ls Lr / Lm^2 - 1) and the
+        // rotor resistance Rr (Ls/Lm)^2 keep its terminal behaviour), Lm the curve's Ls.
+        let (ls, lr) = (lls + lm, llr + lm);
+        (
+            0.0,
+            ls * (ls * lr / (lm * lm) - 1.0),
+            rr * (ls / lm).powi(2),
+            ls,
+        )
+    }
+
+    /// The load's law with the changes in effect: a torque input, or the viscous term.
+    fn load_law(&self, md: &ParameterScales) -> LoadLaw {
+        let (c_nm, w0) = self.eff.coulomb.unwrap_or((0.0, 1.0));
+        let (bl_nms, torque_nm) = if self.torque_load {
+            (0.0, md.torque_nm * md.bl)
+        } else {
+            (self.bl_base * md.bl_scale * md.bl, 0.0)
+        };
+        LoadLaw {
+            bl_nms,
+            torque_nm,
+            coulomb_nm: c_nm,
+            inv_w0: 1.0 / w0,
+            windage: self.eff.windage,
+        }
     }
 
     /// The scenario key a machine that cannot be built is blamed on.

@@ -399,6 +399,43 @@ impl<'a> SimRun<'a> {
         }
     }
 
+    /// The machine at sample `k` (`t` [s]): the events due, the rise `dtemp` [K] from the last
+    /// losses `p_loss` [W], the users' resistance laws; rebuilt where any moved.
+    fn machine_at(
+        &mut self,
+        k: u64,
+        t: f64,
+        next_event: &mut usize,
+        dtemp: &mut f64,
+        p_loss: f64,
+    ) -> Result<(), SimError> {
+        let mut rebuild = self.apply_events(k, next_event);
+        if let Some(new) = self.temperature_rise(t, k, *dtemp, p_loss) {
+            *dtemp = new;
+            let th = self.builder.eff.thermal;
+            let (alpha, rotor) = th.map_or((0.0, false), |h| (h.alpha, h.rotor));
+            self.scales.th_s = 1.0 + alpha * new;
+            self.scales.th_r = if rotor { self.scales.th_s } else { 1.0 };
+            rebuild = true;
+        }
+        if self.builder.eff.has_resistance_laws() {
+            let (ls, lr) = self.builder.eff.resistance_law_scales(t, self.builder.m);
+            rebuild |= (ls, lr) != (self.scales.law_s, self.scales.law_r);
+            (self.scales.law_s, self.scales.law_r) = (ls, lr);
+        }
+        if !rebuild {
+            return Ok(());
+        }
+        let b = &self.builder;
+        let nm = b.build(&self.scales).map_err(|e| SimError::Invalid {
+            key: b.blamed_key().to_string(),
+            message: e.to_string(),
+        })?;
+        nm.take_guess(&self.machine);
+        self.machine = nm;
+        Ok(())
+    }
+
     /// [`SimRun::run`] whose callback may add events ([`simulate_interactive`]).
     pub(super) fn run_with_events(
         mut self,
@@ -413,35 +450,7 @@ impl<'a> SimRun<'a> {
         let mut i_f = self.supply.loop_start(&self.machine);
         for k in 0..self.n {
             let t = k as f64 * self.dt;
-            let mut rebuild = self.apply_events(k, &mut next_event);
-            if let Some(new) = self.temperature_rise(t, k, dtemp, last_p_loss) {
-                dtemp = new;
-                let alpha = self.builder.eff.thermal.map(|th| th.alpha).unwrap_or(0.0);
-                let rotor = self.builder.eff.thermal.is_some_and(|th| th.rotor);
-                self.scales.th_s = 1.0 + alpha * dtemp;
-                self.scales.th_r = if rotor { self.scales.th_s } else { 1.0 };
-                rebuild = true;
-            }
-            // The users' laws of the resistances, once per output sample.
-            if self.builder.eff.has_resistance_laws() {
-                let (ls, lr) = self.builder.eff.resistance_law_scales(t, self.builder.m);
-                if (ls, lr) != (self.scales.law_s, self.scales.law_r) {
-                    self.scales.law_s = ls;
-                    self.scales.law_r = lr;
-                    rebuild = true;
-                }
-            }
-            if rebuild {
-                let nm = self
-                    .builder
-                    .build(&self.scales)
-                    .map_err(|e| SimError::Invalid {
-                        key: self.builder.blamed_key().to_string(),
-                        message: e.to_string(),
-                    })?;
-                nm.take_guess(&self.machine);
-                self.machine = nm;
-            }
+            self.machine_at(k, t, &mut next_event, &mut dtemp, last_p_loss)?;
             // Outputs at t.
             let v = self.supply.voltage(self.supply.p);
             let tr = truth(&self.machine, &x, i_f, v, t, self.supply.we, dtemp);

@@ -7,7 +7,7 @@
 use monitor_analysis::effects::sig;
 use monitor_analysis::leftover::{
     Correlate, Equation, ErrorSpectrum, LawHint, Leftover, LineReading, LineReadingOnLog,
-    NoSpectrum, ShaftAngle, Stretches, Variable, ANGLE_SHARE_MIN,
+    NoSpectrum, OperatingVariable, ShaftAngle, Stretches, ANGLE_SHARE_MIN,
 };
 use monitor_analysis::strata::StratumKind;
 use serde_json::Value;
@@ -237,11 +237,11 @@ fn reading_as(r: &LineReadingOnLog, full: bool) -> String {
 }
 
 /// A variable's name.
-fn variable(v: Variable) -> &'static str {
+fn variable(v: OperatingVariable) -> &'static str {
     match v {
-        Variable::Speed => "the speed",
-        Variable::Load => "the load current",
-        Variable::Voltage => "the voltage",
+        OperatingVariable::Speed => "the speed",
+        OperatingVariable::Load => "the load current",
+        OperatingVariable::Voltage => "the voltage",
     }
 }
 
@@ -443,18 +443,22 @@ mod tests {
                     prominence: 1e6,
                 })
                 .collect(),
-            follows: [Variable::Speed, Variable::Load, Variable::Voltage]
-                .iter()
-                .enumerate()
-                .map(|(k, &variable)| Correlate {
-                    variable,
-                    r: (k > 0).then_some(-0.999),
-                    span: 0.5,
-                    varies: k > 0,
-                    follows: k == 1,
-                    bins: 100,
-                })
-                .collect(),
+            follows: [
+                OperatingVariable::Speed,
+                OperatingVariable::Load,
+                OperatingVariable::Voltage,
+            ]
+            .iter()
+            .enumerate()
+            .map(|(k, &variable)| Correlate {
+                variable,
+                r: (k > 0).then_some(-0.999),
+                span: 0.5,
+                varies: k > 0,
+                follows: k == 1,
+                bins: 100,
+            })
+            .collect(),
             shaft_angle: [1, 2]
                 .iter()
                 .map(|&per_revolution| ShaftAngle {

@@ -29,7 +29,7 @@ pub struct Common {
     #[arg(long, value_delimiter = ',')]
     pub effects: Vec<String>,
     /// A file of your own laws (TOML, `[[law]]` with name, acts_on, expr or table, and
-    /// `[law.parameters]`; docs/model-vs-measurement.md "Your own law"): each law is a
+    /// `[law.parameters]`; docs/your-own-law.md): each law is a
     /// candidate beside the library's effects, fitted and judged the same way, reported by
     /// its name, and `--effects NAME` puts it in the model.
     #[arg(long, value_name = "FILE")]

@@ -96,18 +96,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         inputs.push(l);
     }
     OutputGuard::new(&inputs).check_files(&[&args.out])?;
-    let params = ParamFile::load(&args.params)?;
-    let mut sc = Scenario::load(&args.scenario)?;
-    if let Some(s) = args.seed {
-        sc.seed = s;
-    }
-    let laws = monitor_api::laws::read_laws(args.laws.as_deref())?;
-    monitor_api::laws::check_laws(&laws, &params)?;
-    sc.laws = monitor_api::sim::UserLaws(
-        laws.into_iter()
-            .map(monitor_api::laws::BoundLaw::at_start)
-            .collect(),
-    );
+    let (params, sc) = inputs_of(args)?;
     let work = sc.workload();
     let bytes = work.rows as f64
         * LogWriter::estimated_row_bytes_for(&args.out, sc.sensors.channels()) as f64;
@@ -159,6 +148,27 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     } else {
         render::text::simulate(out, &args.out, wall_s, &summary)
     }
+}
+
+/// The parameter file and the scenario `args` name, the seed and the user's laws (`--laws`,
+/// checked against the file) in it.
+///
+/// # Errors
+/// An unreadable or invalid file, a law that does not check (one line each).
+fn inputs_of(args: &SimulateArgs) -> anyhow::Result<(ParamFile, Scenario)> {
+    let params = ParamFile::load(&args.params)?;
+    let mut sc = Scenario::load(&args.scenario)?;
+    if let Some(s) = args.seed {
+        sc.seed = s;
+    }
+    let laws = monitor_api::laws::read_laws(args.laws.as_deref())?;
+    monitor_api::laws::check_laws(&laws, &params)?;
+    sc.laws = monitor_api::sim::UserLaws(
+        laws.into_iter()
+            .map(monitor_api::laws::BoundLaw::at_start)
+            .collect(),
+    );
+    Ok((params, sc))
 }
 
 /// Refuses a run whose output or integration is beyond the limits.

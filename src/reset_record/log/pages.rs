@@ -180,6 +180,15 @@ fn flush<F: LogFlash>(
     Ok(())
 }
 
+/// The "up" mark: the run before this boot was up long enough (the failed boots' count
+/// ends there).
+const UP_MARK: Mark = Mark {
+    what: UP,
+    count: 1,
+    failed: false,
+    safe_mode: false,
+};
+
 /// The boot's item (module docs of `reset_record::log`): the "up" mark when the previous
 /// run was long up, a full entry for a failed run within the rate limit ([`FULL_ENTRIES`]
 /// since the last "up"), else a count of the reset's kind, added to the counts in RAM
@@ -209,13 +218,7 @@ pub fn record_boot<F: LogFlash>(
     }
     let mut at = locate(flash);
     if boot.previous_long_up {
-        let up = Mark {
-            what: UP,
-            count: 1,
-            failed: false,
-            safe_mode: false,
-        };
-        append(flash, at, &up.encode())?;
+        append(flash, at, &UP_MARK.encode())?;
         at = locate(flash);
     }
     let totals = at.map(|(_, s)| s.totals).unwrap_or_default();

@@ -20,7 +20,7 @@ const ANGLE_MULTIPLES: [u32; 2] = [1, 2];
 /// A variable the error's envelope is set against.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Variable {
+pub enum OperatingVariable {
     /// The measured rotor speed.
     Speed,
     /// The load (active, torque-producing) current I_qs.
@@ -33,7 +33,7 @@ pub enum Variable {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Correlate {
     /// The variable.
-    pub variable: Variable,
+    pub variable: OperatingVariable,
     /// Pearson's correlation of the envelope (the error's RMS per [`BIN_S`] bin, equations
     /// normalised and summed) with the variable's mean per bin, after the start; null where
     /// the log has too few bins or the variable does not vary.
@@ -142,32 +142,36 @@ fn correlates(d: &Prepared, es: &ErrorSeries, runs: &[(usize, usize)]) -> Vec<Co
         }
     }
     let present = [speed, true, voltage];
-    [Variable::Speed, Variable::Load, Variable::Voltage]
-        .into_iter()
-        .zip(vars)
-        .zip(present)
-        .filter(|(_, here)| *here)
-        .map(|((variable, x), _)| {
-            let lo = x.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let mag = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            let span = if mag > 0.0 && hi >= lo {
-                (hi - lo) / mag
-            } else {
-                0.0
-            };
-            let varies = span >= VARIES_MIN && x.len() >= MIN_BINS;
-            let r = varies.then(|| pearson(&env, &x)).flatten();
-            Correlate {
-                variable,
-                r,
-                span,
-                varies,
-                follows: r.is_some_and(|r| r.abs() >= FOLLOWS_MIN),
-                bins: x.len(),
-            }
-        })
-        .collect()
+    [
+        OperatingVariable::Speed,
+        OperatingVariable::Load,
+        OperatingVariable::Voltage,
+    ]
+    .into_iter()
+    .zip(vars)
+    .zip(present)
+    .filter(|(_, here)| *here)
+    .map(|((variable, x), _)| {
+        let lo = x.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let mag = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let span = if mag > 0.0 && hi >= lo {
+            (hi - lo) / mag
+        } else {
+            0.0
+        };
+        let varies = span >= VARIES_MIN && x.len() >= MIN_BINS;
+        let r = varies.then(|| pearson(&env, &x)).flatten();
+        Correlate {
+            variable,
+            r,
+            span,
+            varies,
+            follows: r.is_some_and(|r| r.abs() >= FOLLOWS_MIN),
+            bins: x.len(),
+        }
+    })
+    .collect()
 }
 
 /// Sums of one channel's normalised error `x` over the samples projected: of `x`, of `x^2`,

@@ -35,7 +35,7 @@ mod series;
 #[cfg(test)]
 mod tests;
 
-pub use follows::{Correlate, ShaftAngle, Variable};
+pub use follows::{Correlate, OperatingVariable, ShaftAngle};
 pub use lines::{
     ErrorSpectrum, LineReading, LineReadingOnLog, NoSpectrum, SpectralLine, Stretches,
 };
@@ -355,13 +355,18 @@ fn hint(l: &Leftover) -> Option<LawHint> {
     l.follows
         .iter()
         .filter(|c| c.follows())
-        .filter(|c| matches!(c.variable, Variable::Speed | Variable::Voltage))
+        .filter(|c| {
+            matches!(
+                c.variable,
+                OperatingVariable::Speed | OperatingVariable::Voltage
+            )
+        })
         .max_by(|a, b| {
             let r = |c: &Correlate| c.r.map_or(0.0, f64::abs);
             r(a).total_cmp(&r(b))
         })
         .map(|c| match c.variable {
-            Variable::Voltage => LawHint::MagnetisingOfFlux,
+            OperatingVariable::Voltage => LawHint::MagnetisingOfFlux,
             _ => LawHint::LoadOfSpeed,
         })
 }

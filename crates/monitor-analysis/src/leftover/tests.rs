@@ -222,14 +222,14 @@ fn an_error_that_grows_with_the_speed_follows_it() {
     let sp = l
         .follows
         .iter()
-        .find(|c| c.variable == Variable::Speed)
+        .find(|c| c.variable == OperatingVariable::Speed)
         .expect("speed");
     assert!(sp.varies && sp.follows, "{sp:?}");
     assert!(sp.r.is_some_and(|r| r > 0.9), "{sp:?}");
     let v = l
         .follows
         .iter()
-        .find(|c| c.variable == Variable::Voltage)
+        .find(|c| c.variable == OperatingVariable::Voltage)
         .expect("voltage");
     assert!(!v.varies && v.r.is_none(), "{v:?}");
     assert_eq!(l.hint, Some(LawHint::LoadOfSpeed), "{l:?}");

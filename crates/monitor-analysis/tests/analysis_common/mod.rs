@@ -1,7 +1,7 @@
 //! Shared helpers of the analysis tests: the scenarios and logs of
 //! `monitor_testkit::analysis_common` (re-exported; the full sweeps are described there),
 //! and the analysis run on a log through the library.
-#![allow(dead_code, missing_docs)]
+#![allow(dead_code, missing_docs, unused_imports)]
 
 pub use monitor_testkit::analysis_common::*;
 

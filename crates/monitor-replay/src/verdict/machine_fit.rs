@@ -1,10 +1,10 @@
-//! The machine fitted to the log against the parameter file ([`MachineFit`]): where nothing
+//! The machine fitted to the log against the parameter file ([`StartFit`]): where nothing
 //! was commissioned, a fault present from the first sample moves the residuals as the
 //! file's own error does, and thresholds on the file's values cannot tell them apart. A log
 //! with a start or a load change can: the full-order machine fitted to it (the API runs
 //! `identify` on the log's first seconds) gives each electrical parameter's change from the
 //! file with its interval. One parameter beyond the file's own uncertainty while the others
-//! stay on the file is a fault present from the start ([`MachineFit::finding`]); all of them
+//! stay on the file is a fault present from the start ([`StartFit::finding`]); all of them
 //! on the file is the reach a "healthy" carries.
 
 use super::{Detail, FindingReport};
@@ -63,7 +63,7 @@ impl FittedChange {
 /// The full-order machine fitted to the log's first seconds against the parameter file
 /// (JSON `findings[].reason` of the parameter fit, `kind` `machine_fit`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct MachineFit {
+pub struct StartFit {
     /// The window fitted [s].
     pub from_s: f64,
     /// Its end [s].
@@ -85,7 +85,7 @@ pub const FIT_MAX_ERROR: f64 = 0.05;
 /// (the reach a "healthy" against the file then carries).
 pub const FIT_ON_FILE: f32 = 0.1;
 
-impl MachineFit {
+impl StartFit {
     /// The change of `p`, where the log identified it.
     pub fn change(&self, p: FitParameter) -> Option<&FittedChange> {
         self.changes.iter().find(|c| c.parameter == p)
@@ -180,14 +180,14 @@ fn beyond_share(c: &FittedChange) -> f32 {
 mod tests {
     use super::*;
 
-    fn fit(rs: f32, rr: f32, others: f32, width: f32) -> MachineFit {
+    fn fit(rs: f32, rr: f32, others: f32, width: f32) -> StartFit {
         let c = |parameter, change: f32| FittedChange {
             parameter,
             change,
             low: change - width,
             high: change + width,
         };
-        MachineFit {
+        StartFit {
             from_s: 0.0,
             to_s: 6.0,
             relative_rms_error: 0.004,

@@ -111,7 +111,7 @@ pub enum Detail {
     FileMisfit(FileMisfit),
     /// The full-order machine fitted to the log against the file: a fault present from the
     /// start named, or the machine on the file (the reach of a "healthy").
-    MachineFit(machine_fit::MachineFit),
+    MachineFit(machine_fit::StartFit),
     /// The data-quality stage does not trust the data (the report's
     /// `data_quality.not_trusted_because`).
     DataNotTrusted,

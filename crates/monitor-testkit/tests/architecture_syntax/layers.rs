@@ -13,7 +13,9 @@ pub const INSIDE: &[Inside] = &[
     // self-check's table beside the reset record (it reads the clock's and the supply's
     // constants), the half's read above the recovery and the acquisition, the boot block
     // above the reset record it reads, the start (the registers' sequence that hands the
-    // boot composition its facts) above the boot.
+    // boot composition its facts) above the boot. Issue 88's: the register layer (`regs`, the
+    // binary's only) above the board and the recovery it names; the boot report above the
+    // start whose facts it prints.
     (
         "src/",
         &[
@@ -22,6 +24,7 @@ pub const INSIDE: &[Inside] = &[
             ("liveness", 1),
             ("recovery", 1),
             ("flash_ecc", 2),
+            ("regs", 2),
             ("acquisition", 2),
             ("sampling", 2),
             ("supply", 2),
@@ -39,6 +42,7 @@ pub const INSIDE: &[Inside] = &[
             ("motor_source", 5),
             ("boot", 6),
             ("startup", 7),
+            ("boot_report", 8),
         ],
     ),
     // The parameter file below the logs and the nameplate estimate.

@@ -5,7 +5,7 @@ use super::named::{against_text, fault_text};
 use super::{commissioning, isolation, rotor, winding};
 use monitor_core::verdict::{FindingSource, NamedFault};
 use monitor_io::log::quality::MAX_NOT_JUDGED_FRACTION;
-use monitor_replay::{Detail, DiagnoseReport, FileMisfit, FindingReport};
+use monitor_replay::{Detail, DiagnoseReport, FileMisfit, FindingReport, RangeDeparture};
 
 use crate::spelling::Spelling;
 
@@ -60,29 +60,7 @@ fn summary_of(detail: &Detail, rep: &DiagnoseReport, sp: &dyn Spelling) -> Strin
             outside,
             load_moves,
             rise_k,
-        } => {
-            let mut said = Vec::new();
-            if let Some(d) = outside {
-                said.push(format!(
-                    "outside the commissioned range at the end: {}",
-                    isolation::moved_note(d)
-                ));
-            }
-            if *load_moves > 0 {
-                said.push(format!(
-                    "the load moved {load_moves} time{}",
-                    if *load_moves == 1 { "" } else { "s" }
-                ));
-            }
-            if let Some(rise) = rise_k {
-                said.push(if commissioned(rep) {
-                    format!("the windings warmed by {rise:.0} K since commissioning")
-                } else {
-                    format!("the windings are about {rise:.0} K warmer than the parameter file assumes")
-                });
-            }
-            said.join("; ")
-        }
+        } => operating_point_moved(outside.as_deref(), *load_moves, *rise_k, rep),
         Detail::Commissioned => "commissioned: the residuals are judged against the healthy motor learned in commissioning, not the file's values".into(),
         Detail::ParameterFitUnavailable => {
             "the residuals against the file need the voltages and the speed".into()
@@ -139,6 +117,38 @@ fn summary_of(detail: &Detail, rep: &DiagnoseReport, sp: &dyn Spelling) -> Strin
             summary_of(read, rep, sp)
         ),
     }
+}
+
+/// The sentence of an operating point that moved: outside the commissioned range at the end
+/// (`outside`), the load's moves, the windings' rise [K] (since commissioning, or against
+/// the file).
+fn operating_point_moved(
+    outside: Option<&[RangeDeparture]>,
+    load_moves: usize,
+    rise_k: Option<f32>,
+    rep: &DiagnoseReport,
+) -> String {
+    let mut said = Vec::new();
+    if let Some(d) = outside {
+        said.push(format!(
+            "outside the commissioned range at the end: {}",
+            isolation::moved_note(d)
+        ));
+    }
+    if load_moves > 0 {
+        said.push(format!(
+            "the load moved {load_moves} time{}",
+            if load_moves == 1 { "" } else { "s" }
+        ));
+    }
+    if let Some(rise) = rise_k {
+        said.push(if commissioned(rep) {
+            format!("the windings warmed by {rise:.0} K since commissioning")
+        } else {
+            format!("the windings are about {rise:.0} K warmer than the parameter file assumes")
+        });
+    }
+    said.join("; ")
 }
 
 /// Whether the residuals were judged against a commissioned baseline.

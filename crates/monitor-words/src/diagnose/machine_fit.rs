@@ -5,7 +5,7 @@
 use super::named::pct;
 use monitor_core::isolation::NOMINAL_UNCERTAINTY;
 use monitor_core::verdict::{Against, FindingSource};
-use monitor_replay::{Detail, DiagnoseReport, FitParameter, MachineFit};
+use monitor_replay::{Detail, DiagnoseReport, FitParameter, StartFit};
 
 /// A fitted parameter's name.
 fn name(p: FitParameter) -> &'static str {
@@ -19,7 +19,7 @@ fn name(p: FitParameter) -> &'static str {
 
 /// The parameter fit's sentence: a fault present from the start, or the machine on the
 /// file, with the window and each parameter's change.
-pub(super) fn summary(f: &MachineFit) -> String {
+pub(super) fn summary(f: &StartFit) -> String {
     let changes: Vec<String> = f
         .changes
         .iter()

@@ -380,9 +380,11 @@ fn residuals_chart(rep: &DiagnoseReport) -> Chart<'static> {
 /// end. A residual outside its band lights its lamp: the chart shows why r1 lit and r2 did
 /// not (the fixed bands are one, +/-3 %; the learned ones each residual's own).
 fn threshold_lines(rep: &DiagnoseReport) -> Vec<Series> {
-    let (Some(bands), Some(first), Some(last)) =
-        (rep.threshold_bands, rep.timeline.first(), rep.timeline.last())
-    else {
+    let (Some(bands), Some(first), Some(last)) = (
+        rep.threshold_bands,
+        rep.timeline.first(),
+        rep.timeline.last(),
+    ) else {
         return Vec::new();
     };
     let from = rep

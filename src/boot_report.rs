@@ -4,9 +4,9 @@
 //! terminal. Built without `core::fmt` (no float or generic formatting pulled into the
 //! firmware): fixed-size lines ([`ReportLine`]) of words and decimal or hexadecimal numbers.
 
-use super::log::{Ended, Entry, Totals};
-use super::{PreviousRun, ResetCause, ResetKind, ResetRecord, ResetSource};
 use crate::clock::ClockSource;
+use crate::reset_record::log::{Ended, Entry, Totals};
+use crate::reset_record::{PreviousRun, ResetCause, ResetKind, ResetRecord, ResetSource};
 use crate::self_check::CheckId;
 use crate::startup::{BootFacts, SafeModeReason};
 
