@@ -45,7 +45,7 @@ pub fn check_laws(laws: &[Arc<Law>], params: &ParamFile) -> Result<(), ApiError>
                     monitor_laws::LawOrigin::Library => Default::default(),
                 },
                 law: law.id.name().to_string(),
-                why: LawProblem::Table(e),
+                why: Box::new(LawProblem::Table(e)),
             })
         })?;
     }

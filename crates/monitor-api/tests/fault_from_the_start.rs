@@ -8,6 +8,7 @@
 //! - the same logs without their start (steady running only, nothing to fit): the faulty
 //!   ones are "could not judge" (the log departs from the file, a fault or the file's
 //!   error), the healthy ones "healthy" with the reach of a file's own uncertainty.
+//!
 //! About 2 s in the test profile.
 
 use monitor_api::{self as api, DiagnoseRequest, ParamsSource};

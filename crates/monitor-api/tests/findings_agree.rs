@@ -7,6 +7,7 @@
 //!   candidate dropped, with the fault the verdict names (Ls +50 %: the lamps first matched
 //!   rr);
 //! - heating read against the parameter file is not "since commissioning".
+//!
 //! About 2 s in the test profile.
 
 use monitor_api::{self as api, DiagnoseRequest, ParamsSource};
@@ -71,7 +72,7 @@ fn the_verdict_its_findings_and_its_events_say_one_thing() {
         .verdict_finding
         .as_ref()
         .and_then(|f| f.named())
-        .map(|n| api::words::diagnose::fault_text(n))
+        .map(api::words::diagnose::fault_text)
         .expect("named"); // ok: test
     for (d, s) in r.detections.iter().zip(&said) {
         let s = s.as_str().unwrap_or_default();

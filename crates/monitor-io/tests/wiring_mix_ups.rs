@@ -51,11 +51,12 @@ fn wiring(log: &Path, params: &Path, table: &ColumnsTable) -> Vec<WiringFault> {
     stage.finish().expect("quality").wiring // ok: test
 }
 
+/// A case: its name, the columns table of the mix-up, and the finding that must name it.
+type Case = (&'static str, ColumnsTable, fn(&WiringFault) -> bool);
+
 /// `table` with column `c` reading the channel named `name` (its sign turned where `invert`).
 fn with(mut table: ColumnsTable, c: Column, name: &str, invert: bool) -> ColumnsTable {
-    let e = table
-        .entry(c.name().to_string())
-        .or_insert_with(ColumnEntry::default);
+    let e = table.entry(c.name().to_string()).or_default();
     if e.column.is_none() {
         e.name = Some(name.to_string());
     }
@@ -121,7 +122,7 @@ fn third_party_logs_of_two_sizes_name_each_mix_up_as_wiring_and_its_fix_passes()
         );
         let currents = exchange(none.clone(), Column::Ia, Column::Ic);
         let reversed = with(none.clone(), Column::Ib, "ib_A", true);
-        let cases: [(&str, ColumnsTable, fn(&WiringFault) -> bool); 3] = [
+        let cases: [Case; 3] = [
             ("b and c exchanged in V and I", both, |f| {
                 matches!(
                     f,

@@ -72,7 +72,7 @@ pub enum LawError {
         /// The law's name (or its number when it has none).
         law: String,
         /// What is wrong.
-        why: LawProblem,
+        why: Box<LawProblem>,
     },
 }
 
@@ -213,13 +213,13 @@ impl LawFile {
             let law = build(s, folder, path).map_err(|why| LawError::Law {
                 path: path.to_path_buf(),
                 law: label.clone(),
-                why,
+                why: Box::new(why),
             })?;
             if laws.iter().any(|l| l.id == law.id) {
                 return Err(LawError::Law {
                     path: path.to_path_buf(),
                     law: label.clone(),
-                    why: LawProblem::Duplicate(label),
+                    why: Box::new(LawProblem::Duplicate(label)),
                 });
             }
             laws.push(Arc::new(law));

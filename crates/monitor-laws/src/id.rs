@@ -199,7 +199,7 @@ mod tests {
         assert_eq!(user, EffectId::named(&String::from("compressor")));
         assert_ne!(user, EffectId::named("pump"));
         // The library's order first, the users' by name after it.
-        let mut v = vec![
+        let mut v = [
             EffectId::named("pump"),
             EffectId::library(EffectKind::CrossCouplingDynamics),
             user,

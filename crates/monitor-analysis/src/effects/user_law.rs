@@ -215,7 +215,7 @@ impl LawEffect {
                 ActsOn::MagnetisingCurve => 1.0,
                 _ => self.law.eval(values, &x),
             };
-            (!v.is_finite()).then(|| x.t_s)
+            (!v.is_finite()).then_some(x.t_s)
         })
     }
 
@@ -347,7 +347,7 @@ impl LawOnLog {
 /// law at zero flux): the secant method kept in the bracket `0 ..= 2 lm0 i` (bisection
 /// where a step leaves it), to 1e-12 relative.
 fn solve_flux(lm: &dyn Fn(f64) -> f64, lm0: f64, i: f64) -> f64 {
-    if i <= 0.0 || !(lm0 > 0.0) {
+    if i <= 0.0 || lm0.is_nan() || lm0 <= 0.0 {
         return 0.0;
     }
     let g = |p: f64| p - lm(p) * i;
@@ -475,7 +475,10 @@ mod tests {
         let alt = e.alt_starts(&[5.0, 1.0, 0.5]);
         assert_eq!(alt.len(), 3);
         for s in &alt {
-            assert!((-3.1416..=3.1416).contains(&s[2]) && s[2] != 0.5, "{s:?}");
+            assert!(
+                (-std::f64::consts::PI..=std::f64::consts::PI).contains(&s[2]) && s[2] != 0.5,
+                "{s:?}"
+            );
             assert_eq!(&s[..2], &[5.0, 1.0]);
         }
     }

@@ -155,7 +155,7 @@ mod tests {
         };
         let white: Vec<f64> = (0..2 * n).map(|_| 0.01 * noise()).collect();
         let s2 = white.iter().map(|e| e * e).sum::<f64>() / (2 * n) as f64;
-        let sig_w = sigmas_with_model_error(&[col.clone()], &white, 1e-3, s2, 1e-9)[0];
+        let sig_w = sigmas_with_model_error(std::slice::from_ref(&col), &white, 1e-3, s2, 1e-9)[0];
         let gauss_newton = (s2 / (2 * n) as f64).sqrt();
         assert!(sig_w / gauss_newton < 1.3, "{sig_w} vs {gauss_newton}");
         let wave: Vec<f64> = (0..2 * n)

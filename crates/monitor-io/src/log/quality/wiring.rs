@@ -96,15 +96,13 @@ impl Moments {
     /// The covariance matrix.
     fn cov(&self) -> [[f64; 3]; 3] {
         let n = self.n.max(1.0);
-        let mut c = [[0.0; 3]; 3];
-        for k in 0..3 {
-            for j in k..3 {
-                let v = self.ss[k][j] / n - self.s[k] / n * self.s[j] / n;
-                c[k][j] = v;
-                c[j][k] = v;
-            }
-        }
-        c
+        // Only the upper triangle is summed: (k, j) reads (min, max).
+        std::array::from_fn(|k| {
+            std::array::from_fn(|j| {
+                let (a, b) = (k.min(j), k.max(j));
+                self.ss[a][b] / n - self.s[a] / n * self.s[b] / n
+            })
+        })
     }
 }
 
@@ -124,8 +122,8 @@ impl Cross {
         for k in 0..3 {
             self.sx[k] += x[k];
             self.sy[k] += y[k];
-            for j in 0..3 {
-                self.sxy[k][j] += x[k] * y[j];
+            for (j, yj) in y.iter().enumerate() {
+                self.sxy[k][j] += x[k] * yj;
             }
         }
     }
@@ -133,13 +131,9 @@ impl Cross {
     /// The cross-covariance `cov(x_k, y_j)`.
     fn cov(&self) -> [[f64; 3]; 3] {
         let n = self.n.max(1.0);
-        let mut c = [[0.0; 3]; 3];
-        for k in 0..3 {
-            for j in 0..3 {
-                c[k][j] = self.sxy[k][j] / n - self.sx[k] / n * self.sy[j] / n;
-            }
-        }
-        c
+        std::array::from_fn(|k| {
+            std::array::from_fn(|j| self.sxy[k][j] / n - self.sx[k] / n * self.sy[j] / n)
+        })
     }
 }
 

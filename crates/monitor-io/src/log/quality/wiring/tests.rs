@@ -26,6 +26,8 @@ fn row(t: f64, lag: f64) -> Row {
 /// A mutation of a row's channels (the schema's column indices of the row: voltages 0..3,
 /// currents 3..6, speed 6).
 type Mutation = fn(&mut [f64; 7]);
+/// A case: its name, the change to a row, and the finding that must name it.
+type MutationCase = (&'static str, Mutation, fn(&WiringFault) -> bool);
 
 fn cells(r: &Row) -> [f64; 7] {
     let v = r.v_abc.unwrap_or([0.0; 3]);
@@ -119,7 +121,7 @@ fn a_motor_wired_right_passes_at_every_load() {
 
 #[test]
 fn each_mix_up_is_named_with_the_mapping_that_fixes_it() {
-    let cases: [(&str, Mutation, fn(&WiringFault) -> bool); 8] = [
+    let cases: [MutationCase; 8] = [
         (
             "b and c exchanged in both sets",
             |x| {
