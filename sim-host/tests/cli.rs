@@ -2,6 +2,7 @@
 //! gives a non-zero exit and a one-line message naming the problem.
 
 use assert_cmd::Command;
+use monitor_testkit::text::verdict_line_of;
 use std::path::{Path, PathBuf};
 
 fn bin() -> Command {
@@ -405,21 +406,4 @@ fn every_command_has_a_help_that_teaches() {
             "{cmd} --help shows no example command line:\n{text}"
         );
     }
-}
-
-/// The text's verdict line as one line: the line that starts with `verdict: ` and the lines
-/// it was wrapped onto (indented by four spaces: the text output wraps at 160 characters).
-fn verdict_line_of(text: &str) -> String {
-    let mut lines = text.lines().skip_while(|l| !l.starts_with("verdict: "));
-    let Some(first) = lines.next() else {
-        return String::new();
-    };
-    std::iter::once(first.to_string())
-        .chain(
-            lines
-                .take_while(|l| l.starts_with("    "))
-                .map(|l| l.trim_start().to_string()),
-        )
-        .collect::<Vec<_>>()
-        .join(" ")
 }

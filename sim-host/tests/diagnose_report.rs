@@ -14,6 +14,7 @@
 mod chart_legend;
 
 use assert_cmd::Command;
+use monitor_testkit::text::verdict_line_of;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
@@ -443,21 +444,4 @@ fn nothing_runs_off_the_page_at_a4_or_a_phones_width_in_a_browser() {
         .unwrap_or(0);
     assert!(lines > 2, "{seen}");
     assert!(seen.ends_with("not drawn: r1"), "{seen}");
-}
-
-/// The text's verdict line as one line: the line that starts with `verdict: ` and the lines
-/// it was wrapped onto (indented by four spaces: the text output wraps at 160 characters).
-fn verdict_line_of(text: &str) -> String {
-    let mut lines = text.lines().skip_while(|l| !l.starts_with("verdict: "));
-    let Some(first) = lines.next() else {
-        return String::new();
-    };
-    std::iter::once(first.to_string())
-        .chain(
-            lines
-                .take_while(|l| l.starts_with("    "))
-                .map(|l| l.trim_start().to_string()),
-        )
-        .collect::<Vec<_>>()
-        .join(" ")
 }

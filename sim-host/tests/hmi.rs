@@ -3,6 +3,8 @@
 //! sources through the library: `src/hmi/tests.rs`; the screen: `src/cli/render/hmi.rs`; a real
 //! terminal: `hmi_tmux.rs`.)
 
+use monitor_testkit::text::verdict_line_of;
+
 /// Stdout not a terminal: one status line per reading interval, the events, then exit 0
 /// when standard input ends.
 #[test]
@@ -153,21 +155,4 @@ fn a_log_replay_takes_diagnoses_options_and_refuses_what_it_refuses() {
         assert!(first(&h).contains(bad[0]), "{bad:?}: {}", first(&h));
         assert!(!first(&h).contains("Usage"), "{bad:?}: {}", first(&h));
     }
-}
-
-/// The text's verdict line as one line: the line that starts with `verdict: ` and the lines
-/// it was wrapped onto (indented by four spaces: the text output wraps at 160 characters).
-fn verdict_line_of(text: &str) -> String {
-    let mut lines = text.lines().skip_while(|l| !l.starts_with("verdict: "));
-    let Some(first) = lines.next() else {
-        return String::new();
-    };
-    std::iter::once(first.to_string())
-        .chain(
-            lines
-                .take_while(|l| l.starts_with("    "))
-                .map(|l| l.trim_start().to_string()),
-        )
-        .collect::<Vec<_>>()
-        .join(" ")
 }

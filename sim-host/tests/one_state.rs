@@ -11,6 +11,7 @@ use monitor_io::log::Log;
 use monitor_io::params::ParamFile;
 use monitor_sim::{simulate_to_vec, LoadStep, Scenario};
 use monitor_studies::fault_signatures::{scenario, Protocol};
+use monitor_testkit::text::verdict_line_of;
 use sim_host::hmi::live::LiveSim;
 use sim_host::hmi::{HmiState, Key, Source};
 use std::path::Path;
@@ -249,21 +250,4 @@ fn a_fault_verdict_beside_dark_lamps_says_why() {
         verdict.starts_with("verdict: healthy") && verdict.contains("lamps lit for a load move"),
         "{verdict}"
     );
-}
-
-/// The text's verdict line as one line: the line that starts with `verdict: ` and the lines
-/// it was wrapped onto (indented by four spaces: the text output wraps at 160 characters).
-fn verdict_line_of(text: &str) -> String {
-    let mut lines = text.lines().skip_while(|l| !l.starts_with("verdict: "));
-    let Some(first) = lines.next() else {
-        return String::new();
-    };
-    std::iter::once(first.to_string())
-        .chain(
-            lines
-                .take_while(|l| l.starts_with("    "))
-                .map(|l| l.trim_start().to_string()),
-        )
-        .collect::<Vec<_>>()
-        .join(" ")
 }

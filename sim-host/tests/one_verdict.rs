@@ -17,6 +17,7 @@
 //! profile on 2 cores.
 
 use assert_cmd::Command;
+use monitor_testkit::text::verdict_line_of;
 use rayon::prelude::*;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -504,21 +505,4 @@ fn the_checks_catch_the_contradictions_the_issue_measured() {
         other_stories(&current_only, "thresholds: fixed: |r| > 3.0 %\n").len(),
         2
     );
-}
-
-/// The text's verdict line as one line: the line that starts with `verdict: ` and the lines
-/// it was wrapped onto (indented by four spaces: the text output wraps at 160 characters).
-fn verdict_line_of(text: &str) -> String {
-    let mut lines = text.lines().skip_while(|l| !l.starts_with("verdict: "));
-    let Some(first) = lines.next() else {
-        return String::new();
-    };
-    std::iter::once(first.to_string())
-        .chain(
-            lines
-                .take_while(|l| l.starts_with("    "))
-                .map(|l| l.trim_start().to_string()),
-        )
-        .collect::<Vec<_>>()
-        .join(" ")
 }

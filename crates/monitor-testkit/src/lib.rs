@@ -9,6 +9,7 @@
 //! * [`identify_machines`]: the six machines (0.37 kW to 50 hp) the `identify` tests
 //!   identify, with their nameplates and the start files estimated from them.
 //! * [`small_motor`]: the 0.37 kW and 50 hp machines beside the two reference motors.
+//! * [`text`]: the command line's text as a test reads it (a wrapped verdict line joined).
 //! * [`textbook_machine`]: an independent textbook induction machine (the ladder's logs),
 //!   checked against physics by `tests/textbook_machine_physics.rs`.
 //!
@@ -18,4 +19,5 @@
 pub mod analysis_common;
 pub mod identify_machines;
 pub mod small_motor;
+pub mod text;
 pub mod textbook_machine;
