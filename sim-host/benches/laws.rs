@@ -15,7 +15,6 @@ mod common;
 
 use monitor_analysis::effects::Registry;
 use monitor_analysis::{prep::ReadOptions, Analysis, EffectId, Options};
-use monitor_io::log::{Channels, LogWriter};
 use monitor_io::params::ParamFile;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -46,20 +45,7 @@ fn ensure(path: &Path, p: &ParamFile) {
         return;
     }
     let s: monitor_sim::Scenario = toml::from_str(SCENARIO).expect("the bench's scenario");
-    let channels = Channels {
-        voltages: true,
-        speed: true,
-        encoder: false,
-        temperature: false,
-    };
-    let mut w = LogWriter::create(path, channels).expect("create log");
-    monitor_sim::simulate(p, &s, |r| {
-        let mut r = *r;
-        r.enc_count = None;
-        w.write_row(&r).expect("write row");
-    })
-    .expect("simulate");
-    w.finish().expect("finish log");
+    common::write_log(path, p, &s);
 }
 
 /// `compare` with `effect` (and the laws of `registry`): CPU-s, the fitted coefficient.

@@ -422,34 +422,25 @@ fn a_law_without_a_number_is_refused_as_a_candidate_and_the_ladder_goes_on() {
         "[[law]]\nname = \"broken\"\nacts_on = \"load_torque\"\nexpr = \"ln(t0 - w)\"\n[law.parameters]\nt0 = { start = 5.0, low = 0.0, high = 40.0, unit = \"N m\" }\n",
     )
     .expect("write laws");
-    let out = Command::cargo_bin("sim-host")
-        .expect("the sim-host binary")
-        .args(["compare", "--json", "--laws"])
-        .arg(&laws)
-        .arg("--params")
-        .arg(data().join("kw2p2.toml"))
-        .arg(data().join("kw2p2_pulse1.csv"))
-        .output()
-        .expect("run sim-host");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let out = Command::cargo_bin("sim-host")
-        .expect("the sim-host binary")
-        .args(["explain", "--json", "--laws"])
-        .arg(&laws)
-        .arg("--params")
-        .arg(data().join("kw2p2.toml"))
-        .arg(data().join("kw2p2_pulse1.csv"))
-        .output()
-        .expect("run sim-host");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let run = |command: &str| {
+        let out = Command::cargo_bin("sim-host")
+            .expect("the sim-host binary")
+            .args([command, "--json", "--laws"])
+            .arg(&laws)
+            .arg("--params")
+            .arg(data().join("kw2p2.toml"))
+            .arg(data().join("kw2p2_pulse1.csv"))
+            .output()
+            .expect("run sim-host");
+        assert!(
+            out.status.success(),
+            "{command}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out
+    };
+    run("compare");
+    let out = run("explain");
     let j: Value = serde_json::from_slice(&out.stdout).expect("one JSON document");
     let skipped = j["skipped"].to_string();
     assert!(

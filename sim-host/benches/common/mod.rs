@@ -33,6 +33,17 @@ pub fn ensure_log(path: &Path, p: &ParamFile, secs: f64) {
         rotor: true,
     }];
     let t = Instant::now();
+    write_log(path, p, &s);
+    eprintln!(
+        "generated {} in {:.1} s",
+        path.display(),
+        t.elapsed().as_secs_f64()
+    );
+}
+
+/// Simulates `s` with the motor of `p` into the log at `path`: voltages, currents and
+/// speed (no encoder column).
+pub fn write_log(path: &Path, p: &ParamFile, s: &Scenario) {
     let channels = Channels {
         voltages: true,
         speed: true,
@@ -40,18 +51,13 @@ pub fn ensure_log(path: &Path, p: &ParamFile, secs: f64) {
         temperature: false,
     };
     let mut w = LogWriter::create(path, channels).expect("create log");
-    sim::simulate(p, &s, |r| {
+    sim::simulate(p, s, |r| {
         let mut r = *r;
         r.enc_count = None;
         w.write_row(&r).expect("write row");
     })
     .expect("simulate");
     w.finish().expect("finish log");
-    eprintln!(
-        "generated {} in {:.1} s",
-        path.display(),
-        t.elapsed().as_secs_f64()
-    );
 }
 
 /// The 1, 5 and 15 min load averages (from /proc/loadavg): on a shared machine the wall
