@@ -193,7 +193,7 @@ impl Analysis {
 /// trust the log, the ranking stays in the report but the conclusion is that no effect is
 /// named (the stage's reasons are the report's `data_quality`), and no effect is added.
 pub(super) fn withhold_if_untrusted(mut out: ExplainOutput) -> ExplainOutput {
-    if out.report.data_quality.trusted {
+    if out.report.data_quality.trusted_but_for_the_supply {
         return out;
     }
     out.report.conclusion = ExplainConclusion::Untrusted;

@@ -413,7 +413,7 @@ impl Analysis {
         if !self.data.channels.voltages {
             return Some(StopReason::NoVoltages);
         }
-        (!self.quality.trusted).then_some(StopReason::Untrusted)
+        (!self.quality.trusted_but_for_the_supply).then_some(StopReason::Untrusted)
     }
 }
 

@@ -116,6 +116,12 @@ pub struct DataQuality {
     pub trusted: bool,
     /// Why not trusted.
     pub not_trusted_because: Vec<String>,
+    /// Trusted, or not trusted only because the currents alternate at another frequency
+    /// than the file's supply: the monitor's residuals run at the file's frequency and its
+    /// verdict is withheld, but an analysis that models the log's own voltages (explain, the
+    /// ladder) goes on (a V/f drive below base speed). Not in the JSON (`trusted` is).
+    #[serde(skip)]
+    pub trusted_but_for_the_supply: bool,
 }
 
 fn is_zero(n: &u64) -> bool {
@@ -127,6 +133,8 @@ fn is_zero(n: &u64) -> bool {
 struct QualityFindings {
     warn: Vec<String>,
     distrust: Vec<String>,
+    /// Whether one of `distrust` is the supply's frequency against the file's.
+    supply_differs: bool,
 }
 
 /// A channel whose readings clip ([`crate::log::clipping`]).
@@ -147,6 +155,8 @@ impl DataQuality {
         self.assess_time(&mut found);
         self.assess_cells(supply_hz, &mut found);
         self.trusted = found.distrust.is_empty();
+        self.trusted_but_for_the_supply =
+            found.distrust.len() == usize::from(found.supply_differs);
         self.warnings = found.warn;
         self.not_trusted_because = found.distrust;
     }
@@ -161,7 +171,7 @@ impl DataQuality {
     /// The time's unit and the rows dropped for their time (repeated, backward, not a
     /// number): many scattered ones leave no stretch of the log to trust.
     fn assess_dropped_time(&self, found: &mut QualityFindings) {
-        let QualityFindings { warn, distrust } = found;
+        let QualityFindings { warn, distrust, .. } = found;
         let rows = self.rows_read.max(1) as f64;
         if self.time_unit != TimeUnit::S {
             warn.push(format!(
@@ -190,7 +200,7 @@ impl DataQuality {
     /// The gaps in the time: bridged ones, the share of samples missing, the segments the
     /// log falls into.
     fn assess_gaps(&self, found: &mut QualityFindings) {
-        let QualityFindings { warn, distrust } = found;
+        let QualityFindings { warn, distrust, .. } = found;
         if self.gaps_bridged > 0 {
             warn.push(format!(
                 "{} samples missing in {} gaps (longest {:.4} s), bridged with the real elapsed time",
@@ -218,7 +228,7 @@ impl DataQuality {
 
     /// The sample clock: timestamps corrected onto it, their jitter, irregular intervals.
     fn assess_clock(&self, found: &mut QualityFindings) {
-        let QualityFindings { warn, distrust } = found;
+        let QualityFindings { warn, distrust, .. } = found;
         let rows = self.rows_read.max(1) as f64;
         if self.timestamp_glitches > 0 {
             warn.push(format!(
@@ -279,7 +289,7 @@ impl DataQuality {
     /// The channels: wiring faults, stuck channels, bad cells in short glitches all through
     /// the log.
     fn assess_channels(&self, found: &mut QualityFindings) {
-        let QualityFindings { warn, distrust } = found;
+        let QualityFindings { warn, distrust, .. } = found;
         let rows = self.rows_read.max(1) as f64;
         for w in &self.wiring {
             distrust.push(w.sentence());
@@ -308,9 +318,14 @@ impl DataQuality {
     /// The signals: the currents' frequency against the supply's [Hz], the speed's unit,
     /// clipping channels.
     fn assess_signals(&self, supply_hz: f64, found: &mut QualityFindings) {
-        let QualityFindings { distrust, .. } = found;
+        let QualityFindings {
+            distrust,
+            supply_differs,
+            ..
+        } = found;
         if let Some(f) = self.current_frequency_hz {
             if (f / supply_hz - 1.0).abs() > SUPPLY_MISMATCH {
+                *supply_differs = true;
                 // The monitor's model runs at the file's frequency: judged against another,
                 // every residual moves as a fault's would (a 60 Hz file on a 50 Hz log read
                 // rr +44 %). Not trusted, the verdict withheld.
