@@ -155,8 +155,7 @@ impl DataQuality {
         self.assess_time(&mut found);
         self.assess_cells(supply_hz, &mut found);
         self.trusted = found.distrust.is_empty();
-        self.trusted_but_for_the_supply =
-            found.distrust.len() == usize::from(found.supply_differs);
+        self.trusted_but_for_the_supply = found.distrust.len() == usize::from(found.supply_differs);
         self.warnings = found.warn;
         self.not_trusted_because = found.distrust;
     }
