@@ -591,13 +591,6 @@ LIBRARY_OVERLAP = {
               "effect (Lm0 / (1 + (psi/psi_sat)^n)), which cannot follow a tanh curve"]],
 }
 
-# What the ladder is known not to do yet without the user's law (open, issue 87 items 1-2):
-# on the pump it approximates k |w|^2.7 by windage plus a constant load torque that only
-# trades with it. The test prints it instead of failing.
-KNOWN_GAP_WITHOUT_LAW = {
-    "power": "load_torque named beside windage, trading with it",
-}
-
 # The no-load table's supply voltages (shares of the rated line voltage), rated frequency.
 NOLOAD_SCALES = [0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2]
 
@@ -1067,8 +1060,6 @@ def user_law_entry(m: Machine, lg: Log, out, t, w, made_table):
                                  "integrated from the speed), w the mechanical speed (rad/s)",
                          "parameters": true}
         e["library_overlap"] = LIBRARY_OVERLAP[kind]
-        if kind in KNOWN_GAP_WITHOUT_LAW:
-            e["known_gap_without_law"] = KNOWN_GAP_WITHOUT_LAW[kind]
         fr = shaft_frequencies(t, w, lg, k)
         e["frequencies"] = {
             "note": ("per steady stretch [t_from_s, t_to_s, value]; the shaft frequency is "

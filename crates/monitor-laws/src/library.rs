@@ -10,6 +10,12 @@
 //! | `load_torque` | load torque | `T0` (a constant torque) |
 //! | `saturation` | magnetising inductance | `Lm0 / (1 + (|psi_m| / psi_sat)^n)` |
 //! | `thermal_drift` | stator resistance | `R0 (1 + alpha rise (1 - e^{-(t - t0)/tau}))` for `t >= t0` |
+//!
+//! One more law is not a candidate of the ladder but its yardstick: [`speed_power`], a load
+//! torque of speed to a power `T_ref (|w| / w_ref)^n`, the family that holds windage
+//! (`n = 2`), a viscous load (`n = 1`) and a constant torque on a shaft that turns one way
+//! (`n = 0`). Where two load laws of the ladder's model fit a log only together, the ladder
+//! fits this one law in their place to see whether the log tells them apart.
 
 use crate::id::EffectId;
 use crate::law::{ActsOn, Law, LawForm, LawOrigin, LawParam};
@@ -55,6 +61,24 @@ pub fn heating_rise_k(rise_k: f64, tau_s: f64, t0_s: f64, t_s: f64) -> f64 {
 #[inline(always)]
 pub fn warm_resistance_ohm(r0_ohm: f64, alpha_per_k: f64, rise_k: f64) -> f64 {
     r0_ohm * (1.0 + alpha_per_k * rise_k)
+}
+
+/// The reference speed of [`speed_power_nm`]: 100 rad/s (955 rpm), about the synchronous
+/// speed of a 4-pole 50 Hz machine, so that `T_ref` is a torque of the machine's order
+/// whatever the exponent.
+pub const SPEED_POWER_REF_RAD_S: f64 = 100.0;
+
+/// A load torque of speed to a power [N m], `T_ref (|w| / w_ref)^n sign(w)` at mechanical
+/// speed `w` [rad/s], with `T_ref` [N m] the torque at `w_ref` =
+/// [`SPEED_POWER_REF_RAD_S`] and `n` >= 0 the exponent (2: windage, 1: a viscous load);
+/// 0 at standstill.
+#[inline(always)]
+pub fn speed_power_nm(t_ref_nm: f64, exponent: f64, w_rad_s: f64) -> f64 {
+    if w_rad_s == 0.0 {
+        0.0
+    } else {
+        t_ref_nm * (w_rad_s.abs() / SPEED_POWER_REF_RAD_S).powf(exponent) * w_rad_s.signum()
+    }
 }
 
 /// A library law's parameter (its start and bounds are generic: the analysis sets them up
@@ -149,6 +173,23 @@ pub fn thermal_drift() -> Law {
     )
 }
 
+/// `speed_power` as a law: `T_ref (|w| / w_ref)^n sign(w)` ([`speed_power_nm`]), the
+/// exponent within 0..5. Not one of [`laws`]: the ladder fits it only in place of two load
+/// laws of its model (module doc), never as a candidate of its own, so that a load the
+/// library lacks is still said to be one.
+pub fn speed_power() -> Law {
+    Law {
+        id: EffectId::from_static("speed_power"),
+        acts_on: ActsOn::LoadTorque,
+        params: vec![
+            param("t_ref_nm", "N m", 1.0, -1e5, 1e5),
+            param("exponent", "1", 2.0, 0.0, 5.0),
+        ],
+        form: LawForm::Builtin(|p, x| speed_power_nm(p[0], p[1], x.w_rad_s)),
+        origin: LawOrigin::Library,
+    }
+}
+
 /// The library's closed-form laws ([`Law`] values, module doc).
 pub fn laws() -> Vec<Arc<Law>> {
     [
@@ -194,6 +235,14 @@ mod tests {
             0.0,
             "no rise before it starts"
         );
+        let pump = speed_power().eval(&[10.0, 2.7], &x);
+        assert!((pump + 10.0 * 1.2f64.powf(2.7)).abs() < 1e-9, "{pump}");
+        assert_eq!(
+            speed_power_nm(10.0, 2.0, -120.0),
+            windage_nm(10.0 / 1e4, -120.0),
+            "n = 2 is windage"
+        );
+        assert_eq!(speed_power_nm(10.0, 0.0, 0.0), 0.0, "nothing at standstill");
         for l in laws() {
             assert!(l.id.is_library());
             let v = l.eval(&l.starts(), &x);

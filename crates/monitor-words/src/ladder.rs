@@ -7,8 +7,8 @@ use crate::analysis::{effect_names, skipped};
 use crate::Spelling;
 use monitor_analysis::effects::{sig, ALPHA_CU_PER_K};
 use monitor_analysis::explain::ladder::{
-    BaseChange, FinalFit, LadderReport, LadderStep, NotSeparable, Refusal, StopReason, TestRule,
-    Tried, WhatIsLeft, WhyNotPhysical,
+    AsOne, BaseChange, FinalFit, LadderReport, LadderStep, NotSeparable, Refusal, StopReason,
+    TestRule, Tried, WhatIsLeft, WhyNotPhysical,
 };
 use monitor_analysis::fit::machine::BaseKey;
 use serde_json::Value;
@@ -295,14 +295,31 @@ fn found(r: &LadderReport, f: &FinalFit) -> Vec<String> {
             dynamics.join(", ")
         ));
     }
+    let as_one = |id| f.as_one.iter().any(|a| a.effects.contains(&id));
     for e in f
         .fitted
         .iter()
         .filter(|e| !e.effect.is_dynamics() && !r.start.effects.contains(&e.effect))
+        .filter(|e| !as_one(e.effect))
     {
         found.push(format!("{}: {}", e.effect, e.summary));
     }
+    found.extend(f.as_one.iter().map(one_load));
     found
+}
+
+/// `windage and load_torque are one load on this log, not two: ...`: two load laws of the
+/// chosen model that one law of speed fits as well ([`AsOne`]), with that law.
+pub fn one_load(a: &AsOne) -> String {
+    format!(
+        "{} and {} are one load on this log, not two: one torque of speed fits it as well          ({:.2}x its noise floor, the two {:.2}x), {} N m at synchronous speed going as |w|^{:.1};          neither is a finding alone (the library has no such law: write it as your own)",
+        a.effects[0],
+        a.effects[1],
+        a.ratio_as_one,
+        a.ratio_as_one * a.error_apart / a.error_as_one,
+        sig(a.torque_at_sync_nm),
+        a.exponent
+    )
 }
 
 /// One base change with its interval: `Rs +19 % (±2 %)`; B + Bl where the file holds none

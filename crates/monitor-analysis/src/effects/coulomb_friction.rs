@@ -74,6 +74,12 @@ impl EffectModel for CoulombFriction {
             within: 1.10,
         }]
     }
+    fn load_torque_at(&self, values: &[f64], w_rad_s: f64) -> Option<f64> {
+        match values {
+            [tc] => Some(monitor_laws::library::coulomb_nm(*tc, 1.0, w_rad_s)),
+            _ => None,
+        }
+    }
     fn setup(&self, _d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let t = n.torque_scale_nm;
         let [torque_nm] = &PARAMS;

@@ -246,6 +246,13 @@ impl EffectModel for LoadTorque {
     fn needs(&self) -> Needs {
         Needs::VOLTAGES_AND_SPEED
     }
+    /// One level: a torque of no speed (several levels are steps, no law of speed).
+    fn load_torque_at(&self, values: &[f64], _w_rad_s: f64) -> Option<f64> {
+        match values {
+            [level] => Some(*level),
+            _ => None,
+        }
+    }
     fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         if d.omega_r.is_empty() {
             return Err(SetupError::NoSpeed {

@@ -223,6 +223,14 @@ pub trait EffectModel: Send + Sync {
     fn takes_viscous_part(&self) -> bool {
         false
     }
+    /// The shaft torque [N m] of a load law of speed alone at the mechanical speed `w`
+    /// [rad/s] with the values `values` (in the set-up's order): windage, dry friction, a
+    /// load torque of one level, a user's load law of `w` alone. `None` (the default) for
+    /// an effect that is not one, or values that do not fit it. The ladder's end asks it
+    /// to fit one law of speed in place of two such laws (`explain::ladder`'s `as_one`).
+    fn load_torque_at(&self, _values: &[f64], _w_rad_s: f64) -> Option<f64> {
+        None
+    }
     /// The effect's values as the machine `n` itself has them, for an effect whose
     /// parameters are the machine's own (the rotor time constant Lr/Rr, the transient
     /// inductance sigma Ls): where the base parameters are refitted as the machine's

@@ -138,6 +138,21 @@ impl EffectModel for LawEffect {
     fn takes_viscous_part(&self) -> bool {
         self.law.acts_on == ActsOn::LoadTorque && self.law.uses(Variable::W)
     }
+    /// A load law of the speed alone (no `t`, no `theta`).
+    fn load_torque_at(&self, values: &[f64], w_rad_s: f64) -> Option<f64> {
+        let of_speed_alone = self.law.acts_on == ActsOn::LoadTorque
+            && !self.law.uses(Variable::T)
+            && !self.law.uses(Variable::Theta);
+        let x = LawInputs {
+            t_s: 0.0,
+            w_rad_s,
+            theta_rad: 0.0,
+            psi_m_wb: 0.0,
+        };
+        of_speed_alone
+            .then(|| self.law.eval(values, &x))
+            .filter(|v| v.is_finite())
+    }
     /// A law that gives no number on this log at the fitted values.
     fn contradicted_by(
         &self,

@@ -73,6 +73,12 @@ impl EffectModel for Windage {
     fn takes_viscous_part(&self) -> bool {
         true
     }
+    fn load_torque_at(&self, values: &[f64], w_rad_s: f64) -> Option<f64> {
+        match values {
+            [k] => Some(monitor_laws::library::windage_nm(*k, w_rad_s)),
+            _ => None,
+        }
+    }
     fn setup(&self, d: &Prepared, n: &MachineConstants) -> Result<FitSetup, SetupError> {
         let w = sync_speed_mech(d, n);
         let k = n.torque_scale_nm / (w * w);

@@ -9,6 +9,7 @@
 //! as `compare`'s), from the last step's values, with the six base parameters free
 //! ([`crate::fit::machine`]): the base changes are read there, with their intervals.
 
+use super::as_one::AsOne;
 use super::base::{base_changes, prior_weight, BaseChange, NotSeparable};
 use super::climb::Ladder;
 use super::rung::{nested_from, setup_list};
@@ -40,6 +41,10 @@ pub struct FinalFit {
     pub base: Vec<BaseChange>,
     /// The effects with their values.
     pub fitted: Vec<FittedEffect>,
+    /// Pairs of its load laws the log shows only as one load torque of speed
+    /// ([`super::as_one`]): neither of the two is a finding alone.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub as_one: Vec<AsOne>,
     /// Samples the fit used.
     pub fit_samples: usize,
     /// Its error over time on the working series, as [`super::LadderStep::error_over_time`].
@@ -48,8 +53,8 @@ pub struct FinalFit {
 }
 
 /// The chosen model on the whole working series (`Ladder::on_whole_log`).
-struct WholeLog {
-    error: f64,
+pub(super) struct WholeLog {
+    pub(super) error: f64,
     noise: f64,
     fitted: Vec<FittedEffect>,
     leftover: Option<Leftover>,
@@ -74,8 +79,8 @@ impl Ladder<'_> {
         let Some(set) = nested_from(&an, &rung.models, &rung.fit.effect_params, &[], &fdata) else {
             return Ok(None);
         };
-        let (mf, half) = self.machine_on(&an, &fdata, &set)?;
-        let whole = self.on_whole_log(&mf, true)?;
+        let (mf, half) = self.machine_on(&an, &fdata, &set, true)?;
+        let whole = self.on_whole_log(&rung.models, &mf, true)?;
         let (error, noise) = (whole.error, whole.noise);
         let mut base = base_changes(&mf.scales, &sr.file, &half);
         if sr.fit_base {
@@ -84,6 +89,7 @@ impl Ladder<'_> {
                 c.changed = c.not_separable.is_none();
             }
         }
+        let as_one = self.as_one(&an, &fdata, &mf, error, noise)?;
         let chosen = FinalFit {
             effects: rung.kinds.clone(),
             error,
@@ -92,20 +98,25 @@ impl Ladder<'_> {
             below_start: start_error / error,
             base,
             fitted: whole.fitted,
+            as_one,
             fit_samples: fdata.len(),
             error_over_time: whole.error_over_time,
         };
         Ok(Some((chosen, whole.leftover)))
     }
 
-    /// The chosen model at the machine fit `mf` on the whole working series: its error,
-    /// its noise floor and its effects' values; with `story`, its error over time and where
-    /// that error lives ([`crate::leftover::locate`]).
-    fn on_whole_log(&self, mf: &MachineFit, story: bool) -> Result<WholeLog, AnalysisError> {
-        let (file, rung, sr) = (self.file, &self.rung, &self.series);
+    /// The model of the effects `models` at the machine fit `mf` on the whole working
+    /// series: its error, its noise floor and its effects' values; with `story`, its error
+    /// over time and where that error lives ([`crate::leftover::locate`]).
+    pub(super) fn on_whole_log(
+        &self,
+        models: &[&dyn EffectModel],
+        mf: &MachineFit,
+        story: bool,
+    ) -> Result<WholeLog, AnalysisError> {
+        let (file, sr) = (self.file, &self.series);
         let fin = file.rebased(mf.params(&sr.file));
-        let models: Vec<&dyn EffectModel> = rung.models.clone();
-        let active = setup_list(&fin, &file.data, &models)?;
+        let active = setup_list(&fin, &file.data, models)?;
         let fit = align(
             &active,
             FitResult {
@@ -175,7 +186,7 @@ impl Ladder<'_> {
             MAX_ITER,
             Some(key),
         )?;
-        let e_pin = self.on_whole_log(&pinned, false)?.error;
+        let e_pin = self.on_whole_log(&rung.models, &pinned, false)?.error;
         let removes = if e_pin > noise {
             (e_pin - error) / (e_pin - noise)
         } else {
@@ -203,12 +214,13 @@ impl Ladder<'_> {
     /// analysis of its base) fitted on `fdata` from the last step's values: with the six
     /// base parameters free beside its effects ([`machine::fit_machine`], their 95 %
     /// half-widths), or, where the log cannot refit the base parameters, its effects alone
-    /// on the rung's base (no half-widths).
-    fn machine_on(
+    /// on the rung's base (no half-widths). Without `halves`, no half-widths either.
+    pub(super) fn machine_on(
         &self,
         an: &Analysis,
         fdata: &Prepared,
         set: &[ActiveEffect<'_>],
+        halves: bool,
     ) -> Result<(MachineFit, [Option<f64>; 6]), AnalysisError> {
         let (rung, sr) = (&self.rung, &self.series);
         let w = Weights::new(fdata, 0, usize::MAX);
@@ -222,6 +234,9 @@ impl Ladder<'_> {
                 prior_weight(rung.noise),
                 MAX_ITER,
             )?;
+            if !halves {
+                return Ok((mf, [None; 6]));
+            }
             let half = machine::machine_half_widths(fdata, &sr.file, set, &w, &mf)?;
             return Ok((mf, half));
         }

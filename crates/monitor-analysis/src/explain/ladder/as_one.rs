@@ -1,0 +1,166 @@
+//! What the log cannot tell apart: two load laws of the chosen model that fit it only as
+//! one load torque of speed.
+//!
+//! Two laws of the shaft's torque of speed alone (windage `k w |w|`, dry friction, a load
+//! torque of one level, a user's law of `w`) trade with each other over the speeds a log
+//! visits: over a start and a variac's steps, `k w |w|` less a constant of -3 N m follows a
+//! pump's `k |w|^2.7` closely enough that each of the two passes the step's test, and the
+//! ladder keeps both. Neither is then a finding: the log shows one load torque of speed,
+//! and the library's laws are two pieces of it.
+//!
+//! So the ladder's end fits the law [`monitor_laws::library::speed_power`],
+//! `T_ref (|w| / w_ref)^n sign(w)` (the family of windage, `n = 2`, a viscous load, `n = 1`,
+//! and a constant torque on a shaft that turns one way, `n = 0`), in place of each pair of
+//! load laws of its model, with the base parameters free as in the final fit. Where that
+//! one law of two parameters explains the log as well as the pair (its error beyond the
+//! noise floor at most [`AS_ONE_WITHIN`] more than the pair's), the pair is reported as one
+//! ([`AsOne`]), with the exponent the log shows and the torque at synchronous speed: the
+//! law a user writes (`--laws`) when the library lacks it. A pair the one law cannot
+//! follow (a constant load beside a fan over a start: the load at standstill is no power
+//! of speed; a load that steps) stays two findings.
+
+use super::climb::Ladder;
+use super::rung::nested_from;
+use crate::analysis::{Analysis, AnalysisError};
+use crate::effects::{sync_speed_mech, EffectModel, LawEffect};
+use crate::fit::machine::MachineFit;
+use crate::prep::Prepared;
+use monitor_laws::library::{speed_power, speed_power_nm, SPEED_POWER_REF_RAD_S};
+use monitor_laws::EffectId;
+use serde::Serialize;
+use std::sync::Arc;
+
+/// How much more error beyond the noise floor the one law may leave than the pair and
+/// still be said to fit the log as well (10 %: the pair's two parameters against the one
+/// law's two, on the same fit).
+pub const AS_ONE_WITHIN: f64 = 0.10;
+
+/// Exponents this close to the law's bounds (0 and 5) are the fit's limits, not a reading.
+const EXPONENT_MARGIN: f64 = 0.05;
+
+/// Two load laws of the chosen model that the log shows only as one load torque of speed
+/// (JSON `final_fit.as_one[]`, module doc).
+#[derive(Debug, Clone, Serialize)]
+pub struct AsOne {
+    /// The two effects, in the model's order.
+    pub effects: [EffectId; 2],
+    /// The exponent `n` of the one law `T (|w| / w_s)^n` that fits in their place.
+    pub exponent: f64,
+    /// Its torque at the log's synchronous speed `w_s` [N m].
+    pub torque_at_sync_nm: f64,
+    /// The log's synchronous speed (mechanical) [rad/s].
+    pub sync_speed_rad_s: f64,
+    /// The whole-log error with the one law in place of the two.
+    pub error_as_one: f64,
+    /// Its ratio to the noise floor.
+    pub ratio_as_one: f64,
+    /// The whole-log error of the chosen model (the pair's).
+    pub error_apart: f64,
+}
+
+impl Ladder<'_> {
+    /// The pairs of load laws of speed of the chosen model (fitted as `mf` on `fdata`, its
+    /// effects set up on the analysis `an`; whole-log `error`, `noise` floor) that one law
+    /// of speed fits as well (module doc).
+    ///
+    /// # Errors
+    /// A model that cannot be set up on the log.
+    pub(super) fn as_one(
+        &self,
+        an: &Analysis,
+        fdata: &Prepared,
+        mf: &MachineFit,
+        error: f64,
+        noise: f64,
+    ) -> Result<Vec<AsOne>, AnalysisError> {
+        let models = &self.rung.models;
+        let w_s = sync_speed_mech(fdata, an.setup_constants());
+        let loads: Vec<usize> = (0..models.len())
+            .filter(|&k| !models[k].kind().is_dynamics())
+            .filter(|&k| {
+                let v = mf.effect_params.get(k).map_or(&[][..], Vec::as_slice);
+                models[k].load_torque_at(v, w_s).is_some()
+            })
+            .collect();
+        let mut out = Vec::new();
+        if loads.len() < 2 || !(error > 0.0 && noise > 0.0) {
+            return Ok(out);
+        }
+        let one = LawEffect::new(Arc::new(speed_power()));
+        for (a, &i) in loads.iter().enumerate() {
+            for &j in &loads[a + 1..] {
+                let pair = |w: f64| -> f64 {
+                    [i, j]
+                        .iter()
+                        .filter_map(|&k| models[k].load_torque_at(&mf.effect_params[k], w))
+                        .sum()
+                };
+                let start = one_law_start(pair(SPEED_POWER_REF_RAD_S), pair(w_s), pair(0.5 * w_s));
+                let mut with: Vec<&dyn EffectModel> = Vec::new();
+                let mut values: Vec<Vec<f64>> = Vec::new();
+                for (k, m) in models
+                    .iter()
+                    .enumerate()
+                    .filter(|(k, _)| *k != i && *k != j)
+                {
+                    with.push(*m);
+                    values.push(mf.effect_params[k].clone());
+                }
+                with.push(&one);
+                values.push(start.to_vec());
+                let Some(set) = nested_from(an, &with, &values, &[], fdata) else {
+                    continue;
+                };
+                let (fit, _) = self.machine_on(an, fdata, &set, false)?;
+                let e = self.on_whole_log(&with, &fit, false)?.error;
+                let Some([t_ref, n]) = fit.effect_params.last().and_then(|v| v.get(..2)) else {
+                    continue;
+                };
+                let within = (e - noise) <= (1.0 + AS_ONE_WITHIN) * (error - noise).max(0.0);
+                let reading = *n > EXPONENT_MARGIN && *n < 5.0 - EXPONENT_MARGIN;
+                if within && reading && e.is_finite() {
+                    out.push(AsOne {
+                        effects: [models[i].kind(), models[j].kind()],
+                        exponent: *n,
+                        torque_at_sync_nm: speed_power_nm(*t_ref, *n, w_s),
+                        sync_speed_rad_s: w_s,
+                        error_as_one: e,
+                        ratio_as_one: e / noise,
+                        error_apart: error,
+                    });
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// Where the one law's fit starts: its torque at the reference speed `t_ref` as the pair
+/// gives it, and the exponent the pair shows between half and full synchronous speed
+/// (`t_sync`, `t_half`; 2 where the two do not have one sign).
+fn one_law_start(t_ref: f64, t_sync: f64, t_half: f64) -> [f64; 2] {
+    let ratio = t_sync / t_half;
+    let n = if ratio.is_finite() && ratio > 0.0 {
+        (ratio.ln() / std::f64::consts::LN_2).clamp(0.0, 4.0)
+    } else {
+        2.0
+    };
+    [t_ref, n]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The start reads the exponent of a power law from its two speeds, and falls back to
+    /// windage's where the pair changes sign between them.
+    #[test]
+    fn the_start_reads_the_pairs_exponent() {
+        let law = |w: f64| 3.0 * (w / 100.0).powf(2.7);
+        let [t, n] = one_law_start(law(100.0), law(157.0), law(78.5));
+        assert!((t - 3.0).abs() < 1e-12);
+        assert!((n - 2.7).abs() < 1e-9, "{n}");
+        let [_, n] = one_law_start(1.0, 5.0, -1.0);
+        assert_eq!(n, 2.0);
+    }
+}
