@@ -141,6 +141,7 @@ fn no_output_line_is_longer_than_160_characters() {
             &id,
         ],
         vec!["demo"],
+        vec!["table1"],
         vec!["fleet", &motors, &a, &b, "--store", &store],
         vec!["trend", "--store", &store],
         vec!["trend", "--store", &store, "--motor", "pump_1"],

@@ -233,10 +233,14 @@ pub fn table1(out: &mut dyn std::io::Write, t: &Table1Report) -> anyhow::Result<
         "Table 1 end to end — {}, angle: {}",
         t.motor, t.angle_source
     )?;
-    writeln!(out, "fault           change   measured r1 r2 r3 r4   paper r1 r2 r3 r4   physics r1 r2 r3 r4   isolation (size)       lamps' candidates")?;
-    let bits = |s: &[u8; 4]| s.map(|b| if b == 1 { "I" } else { "0" });
+    // r1..r4 one character apart: the row stays within the 160 columns a crew's
+    // terminal wraps at, the four candidates of an rr row included.
+    writeln!(
+        out,
+        "fault           change   measured  paper       physics   isolation (size)       lamps' candidates"
+    )?;
+    let bits = |s: &[u8; 4]| s.map(|b| if b == 1 { "I" } else { "0" }).join(" ");
     for r in &t.rows {
-        let (m, p, e) = (bits(&r.signature), bits(&r.paper), bits(&r.expected));
         let diff = if r.signature == r.paper { " " } else { "*" };
         let cands: Vec<String> = r
             .candidates
@@ -245,21 +249,12 @@ pub fn table1(out: &mut dyn std::io::Write, t: &Table1Report) -> anyhow::Result<
             .collect();
         writeln!(
             out,
-            "{:<15} {:+5.0} %        {}  {}  {}  {}          {}  {}  {}  {} {diff}          {}  {}  {}  {}   {:<22} {}",
+            "{:<15} {:+5.0} %   {}   {} {diff}   {}   {:<22} {}",
             r.fault.name(),
             100.0 * r.change,
-            m[0],
-            m[1],
-            m[2],
-            m[3],
-            p[0],
-            p[1],
-            p[2],
-            p[3],
-            e[0],
-            e[1],
-            e[2],
-            e[3],
+            bits(&r.signature),
+            bits(&r.paper),
+            bits(&r.expected),
             match (r.named, r.named_change) {
                 (Some(IsolationName::Fault(n)), Some(c)) => format!("{n} ({:+.0} %)", 100.0 * c),
                 (Some(n), _) => n.to_string(),
@@ -268,14 +263,18 @@ pub fn table1(out: &mut dyn std::io::Write, t: &Table1Report) -> anyhow::Result<
                 }
                 (None, _) => format!("none ({})", state_name(r.isolation_state)),
             },
-            if cands.is_empty() { "none".to_string() } else { cands.join(", ") }
+            if cands.is_empty() {
+                "none".to_string()
+            } else {
+                cands.join(", ")
+            }
         )?;
     }
     let phys = t.rows.iter().filter(|r| r.signature == r.expected).count();
     writeln!(
         out,
-        "\n{} of {n} rows equal the paper's Table 1, {phys} of {n} the physically expected signature \
-         ('I' = residual moves; '*' = differs from the paper; see docs/paper-errata.md for why).",
+        "\n{} of {n} rows equal the paper's Table 1, {phys} of {n} the physically expected signature.\n\
+         Signatures r1 r2 r3 r4: 'I' = the residual moves; '*' = differs from the paper (docs/paper-errata.md says why).",
         t.matches_paper,
         n = t.rows.len()
     )?;
