@@ -19,12 +19,27 @@
 mod alloc_tuning;
 mod cli;
 
-use clap::Parser;
+use clap::{CommandFactory, FromArgMatches};
+use std::io::IsTerminal;
 use std::process::ExitCode;
+
+/// The width `--help` is wrapped at: the terminal's, at most this; this where the output is
+/// no terminal (a pager, a file, a test): 160 characters, the widest line any output keeps
+/// to.
+const HELP_WIDTH: usize = 160;
+
+/// The command line, its help wrapped at [`HELP_WIDTH`].
+fn parse() -> Result<cli::Cli, clap::Error> {
+    let mut cmd = cli::Cli::command().max_term_width(HELP_WIDTH);
+    if !std::io::stdout().is_terminal() {
+        cmd = cmd.term_width(HELP_WIDTH);
+    }
+    cli::Cli::from_arg_matches(&cmd.try_get_matches()?)
+}
 
 fn main() -> ExitCode {
     alloc_tuning::keep_freed_memory();
-    let args = match cli::Cli::try_parse() {
+    let args = match parse() {
         Ok(c) => c,
         Err(e) => {
             use clap::error::ErrorKind;

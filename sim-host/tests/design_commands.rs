@@ -18,12 +18,13 @@ fn help(args: &[&str]) -> String {
 }
 
 /// The subcommands a help text lists (the words at the start of the lines under
-/// `Commands:`).
+/// `Commands:`, indented two spaces; a description's wrapped lines are indented further).
 fn subcommands(text: &str) -> Vec<String> {
     text.lines()
         .skip_while(|l| !l.starts_with("Commands:"))
         .skip(1)
         .take_while(|l| l.starts_with("  "))
+        .filter(|l| !l.starts_with("   "))
         .filter_map(|l| l.split_whitespace().next())
         .filter(|c| *c != "help")
         .map(str::to_string)
@@ -35,7 +36,11 @@ fn long_options(text: &str) -> Vec<String> {
     text.lines()
         .skip_while(|l| !l.starts_with("Options:"))
         .filter_map(|l| {
-            // An option line: "  -o, --out <OUT>" or "      --out <OUT>".
+            // An option line: "  -o, --out <OUT>" or "      --out <OUT>" (a description's
+            // wrapped lines are indented further).
+            if l.len() - l.trim_start().len() > 6 {
+                return None;
+            }
             let l = l.trim_start();
             let rest = if let Some(r) = l.strip_prefix("--") {
                 r

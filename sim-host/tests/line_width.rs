@@ -161,3 +161,50 @@ fn no_output_line_is_longer_than_160_characters() {
         long.join("\n")
     );
 }
+
+/// Every `--help` (the top, each command's, each subcommand's) keeps within [`WIDTH`]: clap
+/// wraps it at 160 columns where the output is no terminal, at the terminal's width (at
+/// most 160) where it is one. Before, a command's long description was one line of up to
+/// 900 characters.
+#[test]
+fn no_help_line_is_longer_than_160_characters() {
+    let commands = |text: &str| -> Vec<String> {
+        text.lines()
+            .skip_while(|l| !l.starts_with("Commands:"))
+            .skip(1)
+            .take_while(|l| l.starts_with("  "))
+            .filter(|l| !l.starts_with("   "))
+            .filter_map(|l| l.split_whitespace().next())
+            .filter(|c| *c != "help")
+            .map(str::to_string)
+            .collect()
+    };
+    let help = |args: &[&str]| -> String {
+        let out = Command::cargo_bin("sim-host")
+            .expect("binary") // ok: test
+            .args(args)
+            .arg("--help")
+            .output()
+            .expect("runs"); // ok: test
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let top = help(&[]);
+    let mut texts = vec![(String::new(), top.clone())];
+    for c in commands(&top) {
+        let t = help(&[&c]);
+        for sub in commands(&t) {
+            texts.push((format!("{c} {sub}"), help(&[&c, &sub])));
+        }
+        texts.push((c, t));
+    }
+    assert!(texts.len() >= 15, "{} help texts", texts.len());
+    let long: Vec<String> = texts
+        .iter()
+        .flat_map(|(c, t)| {
+            t.lines()
+                .filter(|l| l.chars().count() > WIDTH)
+                .map(move |l| format!("`{c} --help`: {l}"))
+        })
+        .collect();
+    assert!(long.is_empty(), "{}", long.join("\n"));
+}

@@ -56,6 +56,8 @@ pub enum DesignArg {
 #[derive(Debug, Args)]
 #[command(
     about = "Estimate a parameter file from a motor's nameplate (a starting point, with ranges)",
+    override_usage = "sim-host params from-nameplate [OPTIONS] --power-kw <KW> --voltage-v <V> --current-a <A>\n       \
+--frequency-hz <HZ> --speed-rpm <RPM> --power-factor <PF> --efficiency <ETA>",
     long_about = "Estimate the parameter file of a 3-phase cage induction motor from its \
 nameplate: the T-equivalent circuit (Rs, Rr, Lls, Llr, Lm, per phase of the star equivalent), \
 the poles, the supply, and the mechanics (J, B, Bl).\n\n\
