@@ -336,3 +336,40 @@ fn a_load_pulsing_once_per_revolution_is_placed_at_the_shaft_frequency() {
     );
     assert!(control["hint"].is_null(), "{control:#}");
 }
+
+/// What a log cannot tell apart is said (issue 87 item 2): on motulator's 7.5 kW machine with
+/// dry friction (`tests/data/motulator/kw7p5_coulomb.csv`: a start and variac steps, the shaft
+/// never reversed) the ladder names `coulomb_friction`, and a constant load torque in its
+/// place fits the log as well; the JSON's `final_fit.alike` pairs them with what would tell
+/// them apart (a reversal), and the text says so. The supply-unbalance log, whose winding
+/// asymmetry would fit 5x worse, pairs nothing.
+#[test]
+fn a_constant_torque_and_dry_friction_on_a_shaft_that_never_reverses_are_said_alike() {
+    let data = repo().join("sim-host/tests/data/motulator");
+    let run = |log: &str, params: &str| -> serde_json::Value {
+        let out = ladder(&["--json"], &data.join(params), &data.join(log));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).expect("one JSON document")
+    };
+    let j = run("kw7p5_coulomb.csv", "kw7p5.toml");
+    let alike = &j["final_fit"]["alike"];
+    assert_eq!(alike[0]["effect"], "coulomb_friction", "{alike}");
+    assert_eq!(alike[0]["other"], "load_torque", "{alike}");
+    assert_eq!(alike[0]["apart_by"], "reversal", "{alike}");
+    let summary = j["summary"].as_str().unwrap_or_default();
+    assert!(
+        summary.contains("coulomb_friction and load_torque fit this log alike")
+            && summary.contains("reversal"),
+        "{summary}"
+    );
+    let j = run("kw2p2_unbalance.csv", "kw2p2.toml");
+    assert!(
+        j["final_fit"]["alike"].is_null(),
+        "{}",
+        j["final_fit"]["alike"]
+    );
+}

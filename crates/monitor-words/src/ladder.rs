@@ -5,10 +5,10 @@
 
 use crate::analysis::{effect_names, skipped};
 use crate::Spelling;
-use monitor_analysis::effects::{sig, ALPHA_CU_PER_K};
+use monitor_analysis::effects::{sig, ApartBy, ALPHA_CU_PER_K};
 use monitor_analysis::explain::ladder::{
-    AsOne, BaseChange, FinalFit, LadderReport, LadderStep, NotSeparable, Refusal, StopReason,
-    TestRule, Tried, WhatIsLeft, WhyNotPhysical,
+    Alike, AsOne, BaseChange, FinalFit, LadderReport, LadderStep, NotSeparable, Refusal,
+    StopReason, TestRule, Tried, WhatIsLeft, WhyNotPhysical,
 };
 use monitor_analysis::fit::machine::BaseKey;
 use serde_json::Value;
@@ -303,9 +303,30 @@ fn found(r: &LadderReport, f: &FinalFit) -> Vec<String> {
         .filter(|e| !as_one(e.effect))
     {
         found.push(format!("{}: {}", e.effect, e.summary));
+        found.extend(f.alike.iter().filter(|a| a.effect == e.effect).map(alike));
     }
     found.extend(f.as_one.iter().map(one_load));
     found
+}
+
+/// `load_torque and coulomb_friction fit this log alike (1.01x and 1.02x its noise floor):
+/// ...`: a confusable effect of the library fits as well in the place of one of the chosen
+/// model's ([`Alike`]), with why and what would tell them apart.
+pub fn alike(a: &Alike) -> String {
+    let why = match a.apart_by {
+        ApartBy::Reversal => {
+            "on a shaft that turns one way a constant torque and dry friction are one torque; \
+             a reversal or a run down to standstill tells them apart"
+        }
+        ApartBy::SwappedPhases => {
+            "at one connection a winding's asymmetry and a supply's unbalance add the same \
+             negative-sequence current; two supply phases exchanged at the terminals tell them apart"
+        }
+    };
+    format!(
+        "{} and {} fit this log alike ({:.2}x and {:.2}x its noise floor): {why}",
+        a.effect, a.other, a.ratio, a.ratio_other
+    )
 }
 
 /// `windage and load_torque are one load on this log, not two: ...`: two load laws of the

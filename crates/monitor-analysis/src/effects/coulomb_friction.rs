@@ -1,7 +1,7 @@
 //! `coulomb_friction`: dry friction.
 
 use super::{
-    declared_values, plausible, About, Confusion, Contribution, EffectModel, EffectParam,
+    declared_values, plausible, About, ApartBy, Confusion, Contribution, EffectModel, EffectParam,
     EffectValuesError, FitSetup, SetupError,
 };
 use crate::prep::Prepared;
@@ -72,6 +72,7 @@ impl EffectModel for CoulombFriction {
         &[Confusion {
             with: EffectId::LOAD_TORQUE,
             within: 1.10,
+            apart_by: ApartBy::Reversal,
         }]
     }
     fn load_torque_at(&self, values: &[f64], w_rad_s: f64) -> Option<f64> {

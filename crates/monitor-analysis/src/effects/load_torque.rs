@@ -1,7 +1,7 @@
 //! `load_torque`: the load as a torque input.
 
 use super::{
-    plausible, About, Confusion, Contribution, EffectEvidence, EffectModel, EffectParam,
+    plausible, About, ApartBy, Confusion, Contribution, EffectEvidence, EffectModel, EffectParam,
     EffectValuesError, FitSetup, Needs, SetupError, LOAD_STEP_MIN,
 };
 use crate::change_point::{Cumulative, Search};
@@ -236,6 +236,7 @@ impl EffectModel for LoadTorque {
         &[Confusion {
             with: EffectId::COULOMB_FRICTION,
             within: 1.10,
+            apart_by: ApartBy::Reversal,
         }]
     }
     fn evidence(&self, e: &EffectEvidence<'_>) -> Option<bool> {

@@ -119,6 +119,23 @@ pub struct Confusion {
     pub with: EffectId,
     /// The other effect's score may be up to this factor above this one's (>= 1).
     pub within: f64,
+    /// What kind of log tells the two apart where this one does not.
+    pub apart_by: ApartBy,
+}
+
+/// What tells two confusable effects apart ([`Confusion::apart_by`]), where a log fits them
+/// alike (the ladder's end, `explain::ladder`'s `Alike`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ApartBy {
+    /// A reversal of the shaft (or a run down to standstill): dry friction changes sign
+    /// with the speed, a constant load torque does not; on a shaft that turns one way the
+    /// two are one torque.
+    Reversal,
+    /// Two supply phases exchanged at the motor's terminals: a winding's asymmetry moves
+    /// with the winding, a supply's unbalance stays with the supply; at one connection and
+    /// one operating point both add the same negative-sequence current.
+    SwappedPhases,
 }
 
 /// Facts measured on the log, beside the fit, that can tell confusable effects apart.

@@ -2,8 +2,8 @@
 
 use super::impedance::z1_pos;
 use super::{
-    declared_values, plausible, supply_unbalanced, About, Confusion, Contribution, EffectEvidence,
-    EffectModel, EffectParam, EffectValuesError, FitSetup, Needs, SetupError,
+    declared_values, plausible, supply_unbalanced, About, ApartBy, Confusion, Contribution,
+    EffectEvidence, EffectModel, EffectParam, EffectValuesError, FitSetup, Needs, SetupError,
 };
 use crate::prep::{Prepared, C64};
 use crate::simplified_model::{MachineConstants, ModelTerms, WindingAsymmetryTerm};
@@ -92,6 +92,7 @@ impl EffectModel for PhaseAsymmetry {
         &[Confusion {
             with: EffectId::SUPPLY_UNBALANCE,
             within: 1.25,
+            apart_by: ApartBy::SwappedPhases,
         }]
     }
     fn evidence(&self, e: &EffectEvidence<'_>) -> Option<bool> {

@@ -2,9 +2,9 @@
 
 use super::impedance::{z2_neg, z2_neg_at};
 use super::{
-    declared_values, plausible, supply_unbalanced, sync_speed_mech, About, Confusion, Contribution,
-    EffectEvidence, EffectModel, EffectParam, EffectValuesError, FitSetup, SetupError,
-    VOLTAGE_UNBALANCE_MIN,
+    declared_values, plausible, supply_unbalanced, sync_speed_mech, About, ApartBy, Confusion,
+    Contribution, EffectEvidence, EffectModel, EffectParam, EffectValuesError, FitSetup,
+    SetupError, VOLTAGE_UNBALANCE_MIN,
 };
 use crate::prep::{Prepared, C64};
 use crate::simplified_model::{MachineConstants, ModelTerms};
@@ -68,6 +68,7 @@ impl EffectModel for SupplyUnbalance {
         &[Confusion {
             with: EffectId::PHASE_ASYMMETRY,
             within: 1.25,
+            apart_by: ApartBy::SwappedPhases,
         }]
     }
     fn evidence(&self, e: &EffectEvidence<'_>) -> Option<bool> {

@@ -9,7 +9,7 @@
 //! as `compare`'s), from the last step's values, with the six base parameters free
 //! ([`crate::fit::machine`]): the base changes are read there, with their intervals.
 
-use super::as_one::AsOne;
+use super::apart::{Alike, AsOne};
 use super::base::{base_changes, prior_weight, BaseChange, NotSeparable};
 use super::climb::Ladder;
 use super::rung::{nested_from, setup_list};
@@ -45,6 +45,10 @@ pub struct FinalFit {
     /// ([`super::as_one`]): neither of the two is a finding alone.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub as_one: Vec<AsOne>,
+    /// Its effects that a confusable effect of the library fits as well in their place
+    /// ([`super::apart`]): the log cannot tell the two apart.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub alike: Vec<Alike>,
     /// Samples the fit used.
     pub fit_samples: usize,
     /// Its error over time on the working series, as [`super::LadderStep::error_over_time`].
@@ -56,7 +60,7 @@ pub struct FinalFit {
 pub(super) struct WholeLog {
     pub(super) error: f64,
     noise: f64,
-    fitted: Vec<FittedEffect>,
+    pub(super) fitted: Vec<FittedEffect>,
     leftover: Option<Leftover>,
     error_over_time: Vec<(f64, f64)>,
 }
@@ -90,6 +94,7 @@ impl Ladder<'_> {
             }
         }
         let as_one = self.as_one(&an, &fdata, &mf, error, noise)?;
+        let alike = self.alike(&an, &fdata, &mf, error, noise)?;
         let chosen = FinalFit {
             effects: rung.kinds.clone(),
             error,
@@ -99,6 +104,7 @@ impl Ladder<'_> {
             base,
             fitted: whole.fitted,
             as_one,
+            alike,
             fit_samples: fdata.len(),
             error_over_time: whole.error_over_time,
         };

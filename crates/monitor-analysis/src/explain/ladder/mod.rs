@@ -41,7 +41,7 @@
 //! effect-free control logs of the test matrix (a textbook machine written inside the test,
 //! three sizes, starts and steps: under 10 %), doubled (docs/model-vs-measurement.md).
 
-mod as_one;
+mod apart;
 mod base;
 mod climb;
 mod end;
@@ -53,7 +53,7 @@ mod stepwise;
 #[cfg(test)]
 mod tests;
 
-pub use as_one::{AsOne, AS_ONE_WITHIN};
+pub use apart::{Alike, AsOne, AS_ONE_WITHIN};
 pub use base::{base_changes, BaseChange, NotSeparable, BASE_CHANGE_MIN};
 pub use end::FinalFit;
 pub use refusal::{Refusal, StopReason, WhatIsLeft, WhyNotPhysical};

@@ -1,5 +1,6 @@
 //! What the log cannot tell apart: two load laws of the chosen model that fit it only as
-//! one load torque of speed.
+//! one load torque of speed ([`AsOne`]), and an effect of the chosen model that a
+//! confusable one of the library fits as well in its place ([`Alike`]).
 //!
 //! Two laws of the shaft's torque of speed alone (windage `k w |w|`, dry friction, a load
 //! torque of one level, a user's law of `w`) trade with each other over the speeds a log
@@ -13,16 +14,26 @@
 //! and a constant torque on a shaft that turns one way, `n = 0`), in place of each pair of
 //! load laws of its model, with the base parameters free as in the final fit. Where that
 //! one law of two parameters explains the log as well as the pair (its error beyond the
-//! noise floor at most [`AS_ONE_WITHIN`] more than the pair's), the pair is reported as one
+//! noise floor at most [`AS_ONE_WITHIN`] more than the pair's, or within the band the ladder
+//! stops in, [`super::FLOOR_BAND`]), the pair is reported as one
 //! ([`AsOne`]), with the exponent the log shows and the torque at synchronous speed: the
 //! law a user writes (`--laws`) when the library lacks it. A pair the one law cannot
 //! follow (a constant load beside a fan over a start: the load at standstill is no power
 //! of speed; a load that steps) stays two findings.
+//!
+//! The library declares which of its effects are confusable and what kind of log tells
+//! them apart ([`crate::effects::Confusion`]: a constant load torque and dry friction, by a
+//! reversal; a winding's asymmetry and a supply's unbalance, by two supply phases
+//! exchanged). For each effect of the chosen model with such a partner outside it, the end
+//! fits the model with the partner in its place; where the partner's values are plausible
+//! and it fits the log as well (the same [`AS_ONE_WITHIN`]), the two are said to fit this
+//! log alike, with what would tell them apart ([`Alike`]). The ladder's choice stands (its
+//! values are the ones reported); the other reading is named beside it.
 
 use super::climb::Ladder;
 use super::rung::nested_from;
-use crate::analysis::{Analysis, AnalysisError};
-use crate::effects::{sync_speed_mech, EffectModel, LawEffect};
+use crate::analysis::{Analysis, AnalysisError, FittedEffect};
+use crate::effects::{sync_speed_mech, ApartBy, EffectModel, LawEffect};
 use crate::fit::machine::MachineFit;
 use crate::prep::Prepared;
 use monitor_laws::library::{speed_power, speed_power_nm, SPEED_POWER_REF_RAD_S};
@@ -58,7 +69,125 @@ pub struct AsOne {
     pub error_apart: f64,
 }
 
+/// An effect of the chosen model and a confusable one of the library that fit the log
+/// alike (JSON `final_fit.alike[]`, module doc).
+#[derive(Debug, Clone, Serialize)]
+pub struct Alike {
+    /// The chosen model's effect (the one reported with its values).
+    pub effect: EffectId,
+    /// The library's effect that fits as well in its place.
+    pub other: EffectId,
+    /// What kind of log tells the two apart.
+    pub apart_by: ApartBy,
+    /// The chosen model's whole-log error over its noise floor.
+    pub ratio: f64,
+    /// The same with `other` in the place of `effect`.
+    pub ratio_other: f64,
+}
+
+/// True when a model whose whole-log error is `e` fits the log as well as one at `error`
+/// (both over the floor `noise`): its error beyond the floor at most [`AS_ONE_WITHIN`]
+/// more, or within the band the ladder stops in ([`super::FLOOR_BAND`]): at the floor the
+/// log cannot choose (kw7p5_coulomb: 1.02x with dry friction, 1.023x with a constant torque
+/// in its place, 28 % more of a sliver beyond the floor).
+fn as_well(e: f64, error: f64, noise: f64) -> bool {
+    e.is_finite()
+        && ((e - noise) <= (1.0 + AS_ONE_WITHIN) * (error - noise).max(0.0)
+            || e / noise <= super::FLOOR_BAND)
+}
+
 impl Ladder<'_> {
+    /// The chosen model (fitted as `mf` on `fdata`, set up on `an`) without its effects at
+    /// `drop`, with `add` last (from `start`, or from its own starts), refitted as the final
+    /// fit is (the base parameters free, no half-widths): its whole-log error, its effects'
+    /// values and the fit; `None` when a set-up refuses the series.
+    fn refit_with(
+        &self,
+        an: &Analysis,
+        fdata: &Prepared,
+        mf: &MachineFit,
+        drop: &[usize],
+        add: &dyn EffectModel,
+        start: Option<&[f64]>,
+    ) -> Result<Option<(f64, Vec<FittedEffect>, MachineFit)>, AnalysisError> {
+        let mut with: Vec<&dyn EffectModel> = Vec::new();
+        let mut values: Vec<Vec<f64>> = Vec::new();
+        for (k, m) in self.rung.models.iter().enumerate() {
+            if !drop.contains(&k) {
+                with.push(*m);
+                values.push(mf.effect_params.get(k).cloned().unwrap_or_default());
+            }
+        }
+        let set = match start {
+            Some(s) => {
+                with.push(add);
+                values.push(s.to_vec());
+                nested_from(an, &with, &values, &[], fdata)
+            }
+            None => {
+                let set = nested_from(an, &with, &values, &[add], fdata);
+                with.push(add);
+                set
+            }
+        };
+        let Some(set) = set else {
+            return Ok(None);
+        };
+        let (fit, _) = self.machine_on(an, fdata, &set, false)?;
+        let whole = self.on_whole_log(&with, &fit, false)?;
+        Ok(Some((whole.error, whole.fitted, fit)))
+    }
+
+    /// The effects of the chosen model (fitted as `mf` on `fdata`, set up on `an`;
+    /// whole-log `error`, `noise` floor) that a confusable effect of the library outside it
+    /// fits as well in its place, with plausible values (module doc).
+    ///
+    /// # Errors
+    /// A model that cannot be set up on the log.
+    pub(super) fn alike(
+        &self,
+        an: &Analysis,
+        fdata: &Prepared,
+        mf: &MachineFit,
+        error: f64,
+        noise: f64,
+    ) -> Result<Vec<Alike>, AnalysisError> {
+        let models = &self.rung.models;
+        let mut out = Vec::new();
+        if !(error > 0.0 && noise > 0.0) {
+            return Ok(out);
+        }
+        for (k, m) in models.iter().enumerate() {
+            for conf in m.confused_with() {
+                if m.kind().is_dynamics() || models.iter().any(|x| x.kind() == conf.with) {
+                    continue;
+                }
+                let Some(other) = self.library.iter().find(|x| x.kind() == conf.with) else {
+                    continue;
+                };
+                let Some((e, fitted, _)) =
+                    self.refit_with(an, fdata, mf, &[k], other.as_ref(), None)?
+                else {
+                    continue;
+                };
+                let plausible = fitted
+                    .iter()
+                    .find(|e| e.effect == conf.with)
+                    .is_some_and(|e| e.plausible);
+                if plausible && as_well(e, error, noise) {
+                    out.push(Alike {
+                        effect: m.kind(),
+                        other: conf.with,
+                        apart_by: conf.apart_by,
+                        ratio: error / noise,
+                        ratio_other: e / noise,
+                    });
+                }
+            }
+        }
+        Ok(out)
+    }
+
     /// The pairs of load laws of speed of the chosen model (fitted as `mf` on `fdata`, its
     /// effects set up on the analysis `an`; whole-log `error`, `noise` floor) that one law
     /// of speed fits as well (module doc).
@@ -96,29 +225,16 @@ impl Ladder<'_> {
                         .sum()
                 };
                 let start = one_law_start(pair(SPEED_POWER_REF_RAD_S), pair(w_s), pair(0.5 * w_s));
-                let mut with: Vec<&dyn EffectModel> = Vec::new();
-                let mut values: Vec<Vec<f64>> = Vec::new();
-                for (k, m) in models
-                    .iter()
-                    .enumerate()
-                    .filter(|(k, _)| *k != i && *k != j)
-                {
-                    with.push(*m);
-                    values.push(mf.effect_params[k].clone());
-                }
-                with.push(&one);
-                values.push(start.to_vec());
-                let Some(set) = nested_from(an, &with, &values, &[], fdata) else {
+                let Some((e, _, fit)) =
+                    self.refit_with(an, fdata, mf, &[i, j], &one, Some(&start))?
+                else {
                     continue;
                 };
-                let (fit, _) = self.machine_on(an, fdata, &set, false)?;
-                let e = self.on_whole_log(&with, &fit, false)?.error;
                 let Some([t_ref, n]) = fit.effect_params.last().and_then(|v| v.get(..2)) else {
                     continue;
                 };
-                let within = (e - noise) <= (1.0 + AS_ONE_WITHIN) * (error - noise).max(0.0);
                 let reading = *n > EXPONENT_MARGIN && *n < 5.0 - EXPONENT_MARGIN;
-                if within && reading && e.is_finite() {
+                if reading && as_well(e, error, noise) {
                     out.push(AsOne {
                         effects: [models[i].kind(), models[j].kind()],
                         exponent: *n,
