@@ -5,6 +5,7 @@
 //! fails here, naming it.
 
 use assert_cmd::Command;
+use monitor_testkit::text::help_subcommands as subcommands;
 use std::path::Path;
 
 /// The text of `sim-host ARGS`.
@@ -15,20 +16,6 @@ fn help(args: &[&str]) -> String {
         .output()
         .expect("runs");
     String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-/// The subcommands a help text lists (the words at the start of the lines under
-/// `Commands:`, indented two spaces; a description's wrapped lines are indented further).
-fn subcommands(text: &str) -> Vec<String> {
-    text.lines()
-        .skip_while(|l| !l.starts_with("Commands:"))
-        .skip(1)
-        .take_while(|l| l.starts_with("  "))
-        .filter(|l| !l.starts_with("   "))
-        .filter_map(|l| l.split_whitespace().next())
-        .filter(|c| *c != "help")
-        .map(str::to_string)
-        .collect()
 }
 
 /// The long options (`--name`) a help text lists, without `--help` and `--version`.

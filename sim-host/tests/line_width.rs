@@ -6,6 +6,7 @@
 //! test profile.
 
 use assert_cmd::Command;
+use monitor_testkit::text::help_subcommands as commands;
 use std::path::{Path, PathBuf};
 
 const WIDTH: usize = 160;
@@ -168,17 +169,6 @@ fn no_output_line_is_longer_than_160_characters() {
 /// 900 characters.
 #[test]
 fn no_help_line_is_longer_than_160_characters() {
-    let commands = |text: &str| -> Vec<String> {
-        text.lines()
-            .skip_while(|l| !l.starts_with("Commands:"))
-            .skip(1)
-            .take_while(|l| l.starts_with("  "))
-            .filter(|l| !l.starts_with("   "))
-            .filter_map(|l| l.split_whitespace().next())
-            .filter(|c| *c != "help")
-            .map(str::to_string)
-            .collect()
-    };
     let help = |args: &[&str]| -> String {
         let out = Command::cargo_bin("sim-host")
             .expect("binary") // ok: test

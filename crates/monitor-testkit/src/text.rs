@@ -18,6 +18,21 @@ pub fn verdict_line_of(text: &str) -> String {
         .join(" ")
 }
 
+/// The subcommands a `--help` text lists: the first word of each line under `Commands:`
+/// indented two spaces (a wrapped description's lines are indented further), `help` left
+/// out.
+pub fn help_subcommands(text: &str) -> Vec<String> {
+    text.lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter(|l| !l.starts_with("   "))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .map(str::to_string)
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
