@@ -5,7 +5,9 @@
 //! --effects saturation` named saturation with its exponent at its fit's bound (14.0) as a
 //! finding. About 2 s.
 //!
-//! Over every shipped log (`MONITOR_FULL_SWEEPS=1`): no value `explain` ranks as plausible,
+//! Over every shipped log and scenario (`MONITOR_FULL_SWEEPS=1`: the 17 motulator logs, the
+//! README's, and the project's own `examples/scenarios/effect_*.toml` simulated): no value
+//! `explain` ranks as plausible,
 //! and none the ladder's end reports as plausible, sits at a bound of its fit or outside its
 //! physical range, judged against the effect's own set-up on the log (not the fit's flag).
 
@@ -129,6 +131,40 @@ fn out_of_physics(
     bad
 }
 
+/// The project's own hidden-effect scenarios (`examples/scenarios/effect_*.toml`) simulated
+/// into `dir`, each with the parameter file its header names (`examples/params/X.toml`).
+fn scenario_logs(dir: &Path) -> Vec<(std::path::PathBuf, std::path::PathBuf)> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let mut files: Vec<_> = std::fs::read_dir(root.join("examples/scenarios"))
+        .expect("examples/scenarios") // ok: test
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("effect_") && n.ends_with(".toml"))
+        })
+        .collect();
+    files.sort();
+    files
+        .iter()
+        .map(|f| {
+            let text = std::fs::read_to_string(f).expect("scenario"); // ok: test
+            let at = text
+                .find("examples/params/")
+                .expect("a parameter file named"); // ok: test
+            let name: String = text[at..]
+                .chars()
+                .take_while(|c| !c.is_whitespace() && *c != ')')
+                .collect();
+            let params = root.join(name);
+            let p = ParamFile::load(&params).expect("params"); // ok: test
+            let sc = monitor_sim::Scenario::load(f).expect("scenario"); // ok: test
+            let stem = f.file_stem().and_then(|n| n.to_str()).unwrap_or("log");
+            (write_log(dir, stem, &p, &sc, false), params)
+        })
+        .collect()
+}
+
 #[test]
 fn no_plausible_value_sits_at_a_fit_bound_on_any_shipped_log() {
     if !full_sweeps() {
@@ -136,8 +172,12 @@ fn no_plausible_value_sits_at_a_fit_bound_on_any_shipped_log() {
         return;
     }
     let mut bad = Vec::new();
-    let logs = shipped_logs();
+    let dir = tempfile::tempdir().expect("temp dir"); // ok: test
+    let mut logs = shipped_logs();
     assert!(logs.len() >= 15, "{} logs", logs.len());
+    let ours = scenario_logs(dir.path());
+    assert!(ours.len() >= 9, "{} scenarios", ours.len());
+    logs.extend(ours);
     for (log, params) in &logs {
         let p = ParamFile::load(params).expect("params"); // ok: test
         let a = analyse(log, &p, 0.0);
