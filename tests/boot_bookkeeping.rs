@@ -331,3 +331,30 @@ fn the_safe_mode_does_not_depend_on_the_logs_scan() {
         );
     }
 }
+
+/// The status line is due every second period (`PeriodOutput::status_line`: 100 ms at the
+/// 50 ms period): periods 2, 4, 6 and 8 of the first eight, whatever else the period does.
+#[test]
+fn the_status_line_is_due_every_second_period() {
+    let settings = Settings::DEFAULT;
+    let mut supervisor =
+        Supervisor::new(&settings, PreviousRun::Clean, 0, MonitorStatus::default());
+    let mut state = ThreadState::default();
+    let mut board = Board {
+        block: BootBlock::default().encode(),
+        pets: 0,
+        store: NoStore,
+        pause: NoPause,
+    };
+    let due: Vec<u32> = (1..=8u32)
+        .filter(|&k| {
+            let input = PeriodInput {
+                now_ms: k * PANEL_PERIOD_MS,
+                ..PeriodInput::default()
+            };
+            period(&mut supervisor, &mut state, input, &mut board).status_line
+        })
+        .collect();
+    assert_eq!(2 * PANEL_PERIOD_MS, 100);
+    assert_eq!(due, [2, 4, 6, 8]);
+}

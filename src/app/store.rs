@@ -65,3 +65,18 @@ pub fn carry_out<S: RecordStore>(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// With no acquisition nothing runs that a flash erase could stall: the pause holds
+    /// (`true`: the trait's "stopped"), and resuming is a no-op.
+    #[test]
+    fn with_no_acquisition_the_pause_always_holds() {
+        let mut none = NoPause;
+        assert!(none.pause());
+        none.resume();
+        assert!(none.pause());
+    }
+}

@@ -213,3 +213,123 @@ fn the_brown_out_level_goes_with_the_record() {
         assert_eq!((back.bor_level(), back), (Some(level), rec));
     }
 }
+
+/// The record's bytes as the module docs lay them out, built by hand (the record module's
+/// writer, no `ResetRecord`): `cause` at byte 8, the lengths at 9 and 10, no brown-out
+/// level, texts of `message_len` and `file_len` ASCII letters.
+fn laid_out(cause: u8, message_len: u8, file_len: u8) -> [u8; RESET_RECORD_LEN] {
+    let mut w = FORMAT.writer::<RESET_RECORD_LEN>();
+    w.bytes(&[cause, message_len, file_len, 0xFF]);
+    w.u32(42);
+    w.u32(0);
+    let mut message = [0u8; MESSAGE_LEN];
+    message.fill(b'm');
+    let mut file = [0u8; FILE_LEN];
+    file.fill(b'f');
+    w.bytes(&message);
+    w.bytes(&file);
+    w.finish()
+}
+
+/// Every cause is the module docs' byte 8 (1 = panic ... 7 = the crystal failed) and reads
+/// back as itself; a byte of no cause (0, 8) is no record, though its CRC holds.
+#[test]
+fn every_cause_is_its_documented_byte_and_reads_back_as_itself() {
+    let records = [
+        (
+            ResetRecord::panic("boom", "src/main.rs", 1),
+            1,
+            ResetCause::Panic,
+        ),
+        (ResetRecord::sample_stall(300), 2, ResetCause::SampleStall),
+        (
+            ResetRecord::setup(BootPhase::Flash),
+            3,
+            ResetCause::SetupTimeout,
+        ),
+        (
+            ResetRecord::defmt_panic(BootPhase::Boot, 0x0800_0200),
+            4,
+            ResetCause::DefmtPanic,
+        ),
+        (
+            ResetRecord::hard_fault(None, 0x0800_0100, 0, 0, 0, 0),
+            5,
+            ResetCause::HardFault,
+        ),
+        (
+            ResetRecord::setup_deadline("adc1-calibration", 20),
+            6,
+            ResetCause::SetupDeadline,
+        ),
+        (ResetRecord::clock_failure(), 7, ResetCause::ClockFailure),
+    ];
+    for (rec, byte, cause) in records {
+        let bytes = rec.encode();
+        assert_eq!(bytes[8], byte, "{cause:?}");
+        let back = ResetRecord::decode(&bytes);
+        assert_eq!(back.map(|r| r.cause()), Some(cause));
+        assert_eq!(back, Some(rec));
+    }
+    // The set-up record's number is the phase's index in `BootPhase::ALL` (Flash: 1).
+    assert_eq!(ResetRecord::setup(BootPhase::Flash).line_or_ms(), 1);
+    for cause in [1, 7] {
+        assert!(
+            ResetRecord::decode(&laid_out(cause, 4, 4)).is_some(),
+            "{cause}"
+        );
+    }
+    for no_cause in [0, 8, 0xFF] {
+        assert_eq!(ResetRecord::decode(&laid_out(no_cause, 4, 4)), None);
+    }
+}
+
+/// The lengths' bounds are inclusive (`0..=MESSAGE_LEN`, `0..=FILE_LEN`): a message of
+/// exactly 64 bytes and a file of exactly 40 are kept whole; one byte more in a length
+/// field is no record.
+#[test]
+fn texts_of_exactly_the_longest_length_are_kept_whole_and_one_more_is_no_record() {
+    let message = "m".repeat(MESSAGE_LEN);
+    let file = "f".repeat(FILE_LEN);
+    let rec = ResetRecord::panic(&message, &file, 9);
+    let back = ResetRecord::decode(&rec.encode()).expect("a record of full-length texts");
+    assert_eq!(
+        (back.message(), back.file()),
+        (message.as_str(), file.as_str())
+    );
+    let (m, f) = (MESSAGE_LEN as u8, FILE_LEN as u8);
+    let full = ResetRecord::decode(&laid_out(1, m, f)).expect("the longest lengths");
+    assert_eq!((full.message().len(), full.file().len()), (64, 40));
+    assert_eq!(ResetRecord::decode(&laid_out(1, m + 1, f)), None);
+    assert_eq!(ResetRecord::decode(&laid_out(1, m, f + 1)), None);
+}
+
+/// The stacked LR and the fault status registers as 8 upper-case hexadecimal digits each,
+/// at the fixed places the doc gives (`lr=0x........ cfsr=0x........ hfsr=0x........
+/// bfar=0x........`): every digit 0-9 and A-F appears.
+#[test]
+fn the_fault_registers_are_written_as_upper_case_hexadecimal_digits() {
+    let rec = ResetRecord::hard_fault(None, 0, 0x0123_4567, 0x89AB_CDEF, 0xFEDC_BA98, 0x7654_3210);
+    assert_eq!(
+        rec.message(),
+        "lr=0x01234567 cfsr=0x89ABCDEF hfsr=0xFEDCBA98 bfar=0x76543210"
+    );
+}
+
+/// An exception's number (IPSR - 16: UsageFault, exception 6, is -10; WWDG, the G474's
+/// interrupt 0, is 0; FMAC, its last, RM0440's vector table position 101; 255 the bound)
+/// is written in decimal, a sign and three digits.
+#[test]
+fn an_exceptions_number_is_written_as_a_sign_and_three_decimal_digits() {
+    for (irqn, file) in [
+        (Some(-10), "exception -010"),
+        (Some(-1), "exception -001"),
+        (Some(0), "exception  000"),
+        (Some(101), "exception  101"),
+        (Some(255), "exception  255"),
+        (None, "hard fault"),
+    ] {
+        let rec = ResetRecord::hard_fault(irqn, 0x0800_0100, 0, 0, 0, 0);
+        assert_eq!(rec.file(), file, "{irqn:?}");
+    }
+}

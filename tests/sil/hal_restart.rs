@@ -146,3 +146,30 @@ fn a_dma_error_during_the_wait_for_adc1_is_recovered_before_adc2s_read() {
         assert_eq!(acq.regs.misaligned_halves, 0);
     }
 }
+
+/// A lap (the DMA a half ahead of the reader: samples lost) is reported for the ring it hit
+/// (`Half::Read`'s `lapped`: ADC1's, then ADC2's or the latch's), so the recovery follows
+/// for a lapped latch as for a lapped ADC: the latch's counts are the samples' encoder
+/// positions, and one lap shifts them against the conversions.
+#[test]
+fn a_lap_on_any_ring_is_reported_a_lap_on_the_latch_too() {
+    for (ring, lapped) in [(0, [true, false]), (1, [false, true]), (2, [false, true])] {
+        let mut acq = AdcDmaModel::running();
+        let mut bufs = HalfBuffers::default();
+        for _ in 0..10 {
+            assert!(acq.regs.sample());
+        }
+        acq.regs.lap_on_read[ring] = true;
+        assert_eq!(
+            now(read_half(&mut acq, &mut bufs)),
+            Half::Read { lapped },
+            "ring {ring}"
+        );
+        acq.regs.sample();
+        assert_eq!(
+            now(read_half(&mut acq, &mut bufs)),
+            Half::Read { lapped: [false; 2] },
+            "ring {ring}, the next half"
+        );
+    }
+}

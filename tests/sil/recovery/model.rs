@@ -120,6 +120,9 @@ pub(crate) struct AdcDmaModel {
     pub(crate) error_on_read: Option<(usize, usize)>,
     /// The HAL's reads of each ADC ring (`read_adc`).
     pub(crate) reads: [u32; 2],
+    /// The rings whose next read finds the DMA a lap ahead (samples lost): ADC1's, ADC2's,
+    /// the latch's; once each.
+    pub(crate) lap_on_read: [bool; 3],
 }
 
 /// The acquisition the rig runs: the firmware's sequence over the model.
@@ -165,6 +168,7 @@ impl AdcDmaModel {
                 last_block_bad: [false; 2],
                 error_on_read: None,
                 reads: [0; 2],
+                lap_on_read: [false; 3],
             },
             ring_len: RING_LEN,
         }
@@ -500,10 +504,20 @@ impl RingReads for AdcDmaModel {
                 self.dma[channel].en = false;
             }
         }
-        RingRead::Data
+        match self.lap_on_read.get_mut(i) {
+            Some(lap) if *lap => {
+                *lap = false;
+                RingRead::Lapped
+            }
+            _ => RingRead::Data,
+        }
     }
 
     async fn read_latch(&mut self, _buf: &mut [u16; LATCH_HALF_LEN]) -> RingRead {
-        RingRead::Data
+        if std::mem::take(&mut self.lap_on_read[2]) {
+            RingRead::Lapped
+        } else {
+            RingRead::Data
+        }
     }
 }
