@@ -29,7 +29,7 @@
 //! | bytes | field |
 //! |---|---|
 //! | 0..4 | magic `b"DMRR"` |
-//! | 4..6 | version, `u16` (2) |
+//! | 4..6 | version, `u16` (3) |
 //! | 6..8 | payload length, `u16` (116) |
 //! | 8 | cause: 1 = panic, 2 = sample path stalled, 3 = a set-up step did not finish, 4 = a `defmt` panic, 5 = a HardFault or an unhandled exception, 6 = a set-up step overran its deadline, 7 = the crystal failed (clock security system) |
 //! | 9 | message length (0..=[`MESSAGE_LEN`]) |
