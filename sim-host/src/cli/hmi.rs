@@ -28,12 +28,12 @@ r1..r4 and the fault lamp, each residual as a bar against its threshold band (le
 its value, the fault candidates with their probabilities (and the phase of a winding asymmetry), \
 speed, I_qs, i_ds, V_qs and the supply frequency, the monitor's state (transient, commissioning \
 with progress, healthy, fault), the data-quality warnings, and a strip chart of the residuals over \
-the last 10 s.\n\nThree sources:\n  sim-host hmi                        live simulation of the demo's \
+the last 10 s.\n\nThree sources:\n  sim-host hmi\n      live simulation of the demo's \
 motor (3 hp reference motor, 12-bit noisy sensors); keys switch each Table 1 fault on and off (the \
 paper's Enable_F_* switches), step the load and the supply, and start commissioning\n  \
-sim-host hmi LOG --params P.toml    replay a log through the data-quality stage and the core, as \
+sim-host hmi LOG --params P.toml\n      replay a log through the data-quality stage and the core, as \
 diagnose does, at --speed 1x, 10x or max, with pause and seek\n  cargo fw-run | sim-host hmi \
---stdin   the firmware's defmt status lines\n\nA log replay takes diagnose's options, checked by the \
+--stdin\n      the firmware's defmt status lines\n\nA log replay takes diagnose's options, checked by the \
 same code with the same messages: --commission START:END, --load unknown|viscous, --baseline \
 HEALTHY... (healthy logs of the same motor: the verdict's winding is judged against them), --group \
 NAME (TDMS), --angle, --residuals, --parallel-paths, --turn-calibration; a commissioning window \

@@ -41,7 +41,7 @@ start file's [columns] table (a DAQ's channel names and units) is left out, so t
 reads logs with the standard column names; --keep-columns keeps it, for more logs of the same \
 DAQ.\n\n\
 Example (docs/own-motor.md):\n  \
-sim-host params from-nameplate --power-kw 2.2 --voltage-v 400 --current-a 4.8 --frequency-hz 50 \
+sim-host params from-nameplate --power-kw 2.2 --voltage-v 400 --current-a 4.8 --frequency-hz 50 \\\n    \
 --speed-rpm 1438 --power-factor 0.77 --efficiency 0.863 --out nameplate.toml\n  \
 sim-host identify --params nameplate.toml examples/logs/motulator_2p2kw_dol.csv --out motor.toml\n  \
 sim-host diagnose --params motor.toml run.csv --commission 1.5:2.4"

@@ -13,7 +13,7 @@ use std::path::PathBuf;
 #[command(
     about = "Make a parameter file (from a nameplate)",
     long_about = "Make a parameter file ([motor] and [supply], docs/design.md section 11).\n\n\
-Example:\n  sim-host params from-nameplate --power-kw 2.2 --voltage-v 400 --current-a 4.8 \
+Example:\n  sim-host params from-nameplate --power-kw 2.2 --voltage-v 400 --current-a 4.8 \\\n    \
 --frequency-hz 50 --speed-rpm 1438 --power-factor 0.77 --efficiency 0.863 --out P.toml"
 )]
 pub struct ParamsArgs {
@@ -80,7 +80,7 @@ Each value is written with its range and source as a TOML comment; --json prints
 one JSON document. Without --out the TOML goes to stdout. A nameplate no induction motor can \
 have (efficiency or power factor outside 0..1, a speed at or above synchronous, power that \
 disagrees with sqrt3 V I pf eta) is refused, naming the option.\n\n\
-Example:\n  sim-host params from-nameplate --power-kw 2.2 --voltage-v 400 --current-a 4.8 \
+Example:\n  sim-host params from-nameplate --power-kw 2.2 --voltage-v 400 --current-a 4.8 \\\n    \
 --frequency-hz 50 --speed-rpm 1438 --power-factor 0.77 --efficiency 0.863 --out P.toml\n  \
 sim-host simulate --params P.toml --scenario S.toml --out D.csv"
 )]
