@@ -15,7 +15,7 @@
 //! load laws of its model, with the base parameters free as in the final fit. Where that
 //! one law of two parameters explains the log as well as the pair (its error beyond the
 //! noise floor at most [`AS_ONE_WITHIN`] more than the pair's, or within the band the ladder
-//! stops in, [`super::FLOOR_BAND`]), the pair is reported as one
+//! stops in, [`FLOOR_BAND`]), the pair is reported as one
 //! ([`AsOne`]), with the exponent the log shows and the torque at synchronous speed: the
 //! law a user writes (`--laws`) when the library lacks it. A pair the one law cannot
 //! follow (a constant load beside a fan over a start: the load at standstill is no power
@@ -31,69 +31,28 @@
 //! values are the ones reported); the other reading is named beside it.
 
 use super::climb::Ladder;
+use super::report::{Alike, AsOne};
+use super::rules::{AS_ONE_WITHIN, FLOOR_BAND};
 use super::rung::nested_from;
 use crate::analysis::{Analysis, AnalysisError, FittedEffect};
-use crate::effects::{sync_speed_mech, ApartBy, EffectModel, LawEffect};
+use crate::effects::{sync_speed_mech, EffectModel, LawEffect};
 use crate::fit::machine::MachineFit;
 use crate::prep::Prepared;
 use monitor_laws::library::{speed_power, speed_power_nm, SPEED_POWER_REF_RAD_S};
-use monitor_laws::EffectId;
-use serde::Serialize;
 use std::sync::Arc;
-
-/// How much more error beyond the noise floor the one law may leave than the pair and
-/// still be said to fit the log as well (10 %: the pair's two parameters against the one
-/// law's two, on the same fit).
-pub const AS_ONE_WITHIN: f64 = 0.10;
 
 /// Exponents this close to the law's bounds (0 and 5) are the fit's limits, not a reading.
 const EXPONENT_MARGIN: f64 = 0.05;
 
-/// Two load laws of the chosen model that the log shows only as one load torque of speed
-/// (JSON `final_fit.as_one[]`, module doc).
-#[derive(Debug, Clone, Serialize)]
-pub struct AsOne {
-    /// The two effects, in the model's order.
-    pub effects: [EffectId; 2],
-    /// The exponent `n` of the one law `T (|w| / w_s)^n` that fits in their place.
-    pub exponent: f64,
-    /// Its torque at the log's synchronous speed `w_s` [N m].
-    pub torque_at_sync_nm: f64,
-    /// The log's synchronous speed (mechanical) [rad/s].
-    pub sync_speed_rad_s: f64,
-    /// The whole-log error with the one law in place of the two.
-    pub error_as_one: f64,
-    /// Its ratio to the noise floor.
-    pub ratio_as_one: f64,
-    /// The whole-log error of the chosen model (the pair's).
-    pub error_apart: f64,
-}
-
-/// An effect of the chosen model and a confusable one of the library that fit the log
-/// alike (JSON `final_fit.alike[]`, module doc).
-#[derive(Debug, Clone, Serialize)]
-pub struct Alike {
-    /// The chosen model's effect (the one reported with its values).
-    pub effect: EffectId,
-    /// The library's effect that fits as well in its place.
-    pub other: EffectId,
-    /// What kind of log tells the two apart.
-    pub apart_by: ApartBy,
-    /// The chosen model's whole-log error over its noise floor.
-    pub ratio: f64,
-    /// The same with `other` in the place of `effect`.
-    pub ratio_other: f64,
-}
-
 /// True when a model whose whole-log error is `e` fits the log as well as one at `error`
 /// (both over the floor `noise`): its error beyond the floor at most [`AS_ONE_WITHIN`]
-/// more, or within the band the ladder stops in ([`super::FLOOR_BAND`]): at the floor the
+/// more, or within the band the ladder stops in ([`FLOOR_BAND`]): at the floor the
 /// log cannot choose (kw7p5_coulomb: 1.02x with dry friction, 1.023x with a constant torque
 /// in its place, 28 % more of a sliver beyond the floor).
 fn as_well(e: f64, error: f64, noise: f64) -> bool {
     e.is_finite()
         && ((e - noise) <= (1.0 + AS_ONE_WITHIN) * (error - noise).max(0.0)
-            || e / noise <= super::FLOOR_BAND)
+            || e / noise <= FLOOR_BAND)
 }
 
 impl Ladder<'_> {

@@ -5,6 +5,8 @@
 
 use super::climb::Ladder;
 use super::refusal::WhyNotPhysical;
+use super::report::BaseChange;
+use super::rules::BASE_CHANGE_MIN;
 use super::rung::{implausible_step, nested, nested_from, setup_list, Fitted, LadderSeries, Rung};
 use crate::analysis::{Analysis, AnalysisError, MAX_ITER};
 use crate::effects;
@@ -13,56 +15,6 @@ use crate::fit::machine::{self, BaseKey, MachineFit, MachineScales, UNIDENTIFIED
 use crate::fit::FitResult;
 use crate::metrics;
 use crate::simplified_model::BaseParams;
-use serde::Serialize;
-
-/// A refitted value that differs from the file's by less than this (3 %) is not a change
-/// the ladder names, whatever its interval.
-pub const BASE_CHANGE_MIN: f64 = 0.03;
-
-/// One base parameter against the user's file (JSON `ladder[].base[]`, `base_changes[]`).
-#[derive(Debug, Clone, Serialize)]
-pub struct BaseChange {
-    /// Which (`rs`, `rr`, `leakage`, `lm`, `j`, `b`).
-    pub base: BaseKey,
-    /// The relative change from the file (0.19 = +19 %); for B + Bl where the file has
-    /// none, the value itself [N m s/rad].
-    pub change: f64,
-    /// The 95 % interval of `change` (`None`: the log does not determine it).
-    pub interval: Option<[f64; 2]>,
-    /// The file's value.
-    pub file_value: f64,
-    /// The refitted value.
-    pub value: f64,
-    /// The unit of the two values.
-    pub unit: &'static str,
-    /// True when the log determines the value within ±[`UNIDENTIFIED_SD`].
-    pub identified: bool,
-    /// True when the change is one the ladder names: identified, at least
-    /// [`BASE_CHANGE_MIN`], its interval excludes no change, and it is the log's own
-    /// evidence (not [`BaseChange::not_separable`]).
-    pub changed: bool,
-    /// The change the fit reads, but the same model without it still explains the log
-    /// (the ladder's end, `Ladder::final_fit`): it trades with the effects' values on this
-    /// log and is no finding.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub not_separable: Option<NotSeparable>,
-}
-
-/// A base change the log cannot tell from the effects' values (JSON
-/// `base_changes[].not_separable`, `final_fit.base[].not_separable`): the chosen model
-/// refitted with the parameter at the file's value.
-#[derive(Debug, Clone, Serialize)]
-pub struct NotSeparable {
-    /// The whole-log error without the change.
-    pub error_without: f64,
-    /// Its ratio to the noise floor.
-    pub ratio_without: f64,
-    /// The share of the error beyond the floor the change removes.
-    pub removes: f64,
-    /// The effects whose values took the change up (by more than 0.5 %; empty: none did,
-    /// the other base parameters or nothing carry it).
-    pub traded_with: Vec<monitor_laws::EffectId>,
-}
 
 /// The file's value of `key` and its unit.
 fn file_value(key: BaseKey, p: &monitor_io::params::ParamFile) -> (f64, &'static str) {

@@ -4,9 +4,11 @@
 //! round found), and the climb, round by round ([`Ladder::round`] says the rung order),
 //! until it stops ([`StopReason`]).
 
+use super::refusal::Tried;
 use super::refusal::{StopReason, WhatIsLeft};
+use super::report::{LadderProgress, LadderReport, LadderStart, LadderStep};
+use super::rules::FLOOR_BAND;
 use super::rung::{LadderSeries, Rung};
-use super::{LadderProgress, LadderReport, LadderStart, LadderStep, Tried, FLOOR_BAND};
 use crate::analysis::{Analysis, AnalysisError, Options};
 use crate::effects::EffectModel;
 use crate::explain::Skipped;

@@ -9,9 +9,10 @@
 //! as `compare`'s), from the last step's values, with the six base parameters free
 //! ([`crate::fit::machine`]): the base changes are read there, with their intervals.
 
-use super::apart::{Alike, AsOne};
-use super::base::{base_changes, prior_weight, BaseChange, NotSeparable};
+use super::base::{base_changes, prior_weight};
 use super::climb::Ladder;
+use super::report::{FinalFit, NotSeparable};
+use super::rules::FLOOR_BAND;
 use super::rung::{nested_from, setup_list};
 use crate::analysis::{align, Analysis, AnalysisError, FittedEffect, MAX_ITER};
 use crate::effects::EffectModel;
@@ -21,40 +22,6 @@ use crate::leftover::Leftover;
 use crate::metrics::{self, Weights};
 use crate::prep::Prepared;
 use crate::simplified_model::BaseParams;
-use monitor_laws::EffectId;
-use serde::Serialize;
-
-/// The chosen model refitted on the whole log (JSON `final_fit`).
-#[derive(Debug, Clone, Serialize)]
-pub struct FinalFit {
-    /// The effects of the chosen model.
-    pub effects: Vec<EffectId>,
-    /// `normalized_rms_error` over the whole log.
-    pub error: f64,
-    /// The whole log's noise floor for the model.
-    pub noise_floor: f64,
-    /// `error / noise_floor`.
-    pub ratio_to_floor: f64,
-    /// The start's error over this one.
-    pub below_start: f64,
-    /// The six base parameters against the user's file, with their intervals.
-    pub base: Vec<BaseChange>,
-    /// The effects with their values.
-    pub fitted: Vec<FittedEffect>,
-    /// Pairs of its load laws the log shows only as one load torque of speed
-    /// ([`super::as_one`]): neither of the two is a finding alone.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub as_one: Vec<AsOne>,
-    /// Its effects that a confusable effect of the library fits as well in their place
-    /// ([`super::apart`]): the log cannot tell the two apart.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub alike: Vec<Alike>,
-    /// Samples the fit used.
-    pub fit_samples: usize,
-    /// Its error over time on the working series, as [`super::LadderStep::error_over_time`].
-    #[serde(skip)]
-    pub error_over_time: Vec<(f64, f64)>,
-}
 
 /// The chosen model on the whole working series (`Ladder::on_whole_log`).
 pub(super) struct WholeLog {
@@ -150,7 +117,7 @@ impl Ladder<'_> {
                 let m = crate::leftover::Measured {
                     error,
                     noise_floor: noise,
-                    band: super::FLOOR_BAND,
+                    band: FLOOR_BAND,
                 };
                 crate::leftover::locate(&file.data, &fin.constants, &pred, m)
             })
@@ -167,7 +134,7 @@ impl Ladder<'_> {
     /// Whether the change of `key` the fit `mf` reads (whole-log error `error`, floor
     /// `noise`) is the log's own evidence: the same model refitted with `key` held at the
     /// file's value. Where that model still explains the log within the noise-floor band
-    /// ([`super::FLOOR_BAND`]), the change only trades with the effects' values (or the
+    /// ([`FLOOR_BAND`]), the change only trades with the effects' values (or the
     /// other base parameters): it is not separable on this log ([`NotSeparable`]), not a
     /// finding. (A model above the band keeps its changes: the error the effects leave is
     /// not the change's to carry, and a small true change removes little of it.)
@@ -198,7 +165,7 @@ impl Ladder<'_> {
         } else {
             0.0
         };
-        if e_pin / noise > super::FLOOR_BAND {
+        if e_pin / noise > FLOOR_BAND {
             return Ok(None);
         }
         let traded_with = rung

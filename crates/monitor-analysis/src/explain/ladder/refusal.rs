@@ -3,7 +3,6 @@
 //! ladder stopped ([`StopReason`]). The ladder decides by matching on them; the words a
 //! crew reads are spelled from them at the door (`monitor-words`).
 
-use super::{Stop, Tried};
 use monitor_laws::EffectId;
 use serde::Serialize;
 
@@ -20,8 +19,8 @@ pub enum Refusal {
         why: Vec<WhyNotPhysical>,
     },
     /// It removes `share` of the held-back error beyond the noise floor (each parameter
-    /// costing [`super::PARAM_PENALTY`]), less than the test's `asks`
-    /// ([`super::STEP_MIN`]).
+    /// costing [`crate::explain::PARAM_PENALTY`]), less than the test's `asks`
+    /// ([`super::rules::STEP_MIN`]).
     BelowTest {
         /// The share removed (0..1).
         share: f64,
@@ -125,7 +124,7 @@ pub enum StopReason {
         heldback_error: f64,
         /// Its noise floor.
         heldback_noise_floor: f64,
-        /// The band ([`super::FLOOR_BAND`]).
+        /// The band ([`super::rules::FLOOR_BAND`]).
         band: f64,
     },
     /// No plausible candidate passed the step's test.
@@ -182,4 +181,36 @@ pub enum WhatIsLeft {
     /// Not explained by the library's effects on the file's base parameters (the base
     /// rung was not a candidate).
     OnTheFileBase,
+}
+
+/// A candidate of the last round that was not kept, and why (JSON `last_round`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Tried {
+    /// True for the base rung (the base parameters refitted; `added` is then empty).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub base: bool,
+    /// The effect (with what it needed first, as in [`super::report::LadderStep::added`]).
+    pub added: Vec<EffectId>,
+    /// Its held-back error.
+    pub heldback_error: f64,
+    /// Its test statistic ([`super::report::LadderStep::significance`]).
+    pub significance: f64,
+    /// Why it was not kept.
+    pub refusal: Refusal,
+}
+
+/// Why the ladder stopped (JSON `stop`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stop {
+    /// The error is within the noise-floor band on the whole log and the held-back part.
+    NoiseFloor,
+    /// No plausible candidate passed the step's test.
+    NothingHelps,
+    /// Every effect of the library is in the model.
+    LibraryExhausted,
+    /// The model cannot run on the log (no voltages).
+    NoModel,
+    /// The data-quality stage does not trust the log: nothing is claimed from it.
+    Untrusted,
 }

@@ -3,8 +3,8 @@
 //! fitted step is not physical.
 
 use super::refusal::WhyNotPhysical;
+use super::rules::{LADDER_FIT_SAMPLES, LADDER_MAX_FIT_SAMPLES};
 use super::split::{mask_on, weights_for};
-use super::{fit_thinning, LADDER_FIT_SAMPLES};
 use crate::analysis::{align, coarsen, Analysis, AnalysisError};
 use crate::base_range::base_newly_out_of_range;
 use crate::effects::{self, EffectModel};
@@ -308,4 +308,25 @@ fn fastest_dynamics_s(n: &crate::simplified_model::MachineConstants) -> f64 {
         .filter_map(|e| e.time_constant_s(n))
         .filter(|t| t.is_finite() && *t > 0.0)
         .fold(f64::INFINITY, f64::min)
+}
+
+/// The thinning factor of the fit copy of a working series of `len` samples at `dt_s`: the
+/// factor that brings it to [`LADDER_FIT_SAMPLES`], but never so coarse that the fastest
+/// dynamics time constant `tau_s` has fewer than 3 samples (the rule of
+/// [`crate::transients::not_proposed`]) while the copy stays within
+/// [`LADDER_MAX_FIT_SAMPLES`]: a 24 s log at 2 kHz is fitted at 1 kHz (24 000 samples)
+/// where a factor of 3 (667 Hz) left a 3.6 ms stator transient unresolved and every
+/// dynamics effect refused.
+pub fn fit_thinning(len: usize, dt_s: f64, tau_s: f64) -> usize {
+    let budget = len.div_ceil(LADDER_FIT_SAMPLES).max(1);
+    let resolving = if tau_s.is_finite() && dt_s > 0.0 {
+        ((tau_s / (3.0 * dt_s)).floor() as usize).max(1)
+    } else {
+        budget
+    };
+    if budget <= resolving {
+        budget
+    } else {
+        resolving.max(len.div_ceil(LADDER_MAX_FIT_SAMPLES).max(1))
+    }
 }

@@ -1,7 +1,8 @@
 //! The held-back split of the ladder, stratified by the log's events (the start, transients,
 //! load moves, steady stretches): every kind of event falls in both parts.
 
-use super::{Stratum, EVENT_WINDOW_MAX_S, WINDOW_MAX_S, WINDOW_MIN_PERIODS};
+use super::report::Stratum;
+use super::rules::{EVENT_WINDOW_MAX_S, WINDOW_MAX_S, WINDOW_MIN_PERIODS};
 use crate::metrics::Weights;
 use crate::prep::Prepared;
 use crate::simplified_model::MachineConstants;

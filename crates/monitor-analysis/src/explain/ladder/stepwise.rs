@@ -6,8 +6,9 @@
 //! here is the ladder's own, on the held-back windows).
 
 use super::climb::Ladder;
+use super::report::{Dropped, LadderStep};
+use super::rules::STEP_MIN;
 use super::rung::{nested_from, Rung};
-use super::{Dropped, LadderStep, STEP_MIN};
 use crate::analysis::{Analysis, AnalysisError};
 use crate::effects::EffectModel;
 use crate::explain::{explained_fraction, PARAM_PENALTY};

@@ -9,7 +9,9 @@ use crate::fit::BaseSpec;
 use crate::prep::ReadOptions;
 use crate::simplified_model::BaseParams;
 use monitor_io::params::ParamFile;
+use monitor_laws::EffectId;
 use monitor_testkit::textbook_machine::{write_log, Machine, Scenario, Supply};
+use std::collections::BTreeMap;
 
 /// The 2.2 kW textbook machine driving a fan (its whole load, no viscous load) through a
 /// start and two voltage steps, 7 s at 4 kHz, with the file's values.

@@ -3,11 +3,11 @@
 //! the step's test ([`STEP_MIN`]) and lowers the whole-log error kept, the others refused
 //! with why ([`Refusal`]), and the step's report.
 
-use super::super::base::BaseChange;
 use super::super::climb::Ladder;
-use super::super::refusal::Refusal;
+use super::super::refusal::{Refusal, Tried};
+use super::super::report::{BaseChange, LadderStep, RangedValue};
+use super::super::rules::STEP_MIN;
 use super::super::rung::{Fitted, Rung};
-use super::super::{LadderStep, RangedValue, Tried, STEP_MIN};
 use crate::analysis::{Analysis, AnalysisError};
 use crate::effects::{self, EffectModel};
 use crate::explain::explained_fraction;

@@ -2,8 +2,8 @@
 //! fitted to convergence, the round's best refitted with every value of the model free.
 
 use super::super::climb::Ladder;
+use super::super::rules::{FINALISTS, SCREEN_ITER};
 use super::super::rung::{implausible_step, nested, nested_from, Fitted, Rung};
-use super::super::{FINALISTS, SCREEN_ITER};
 use crate::analysis::{Analysis, AnalysisError, MAX_ITER};
 use crate::effects::EffectModel;
 use crate::fit::{self, BaseSpec};

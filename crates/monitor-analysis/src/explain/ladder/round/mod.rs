@@ -14,8 +14,10 @@ mod choice;
 mod fits;
 
 use super::climb::Ladder;
+use super::refusal::Tried;
+use super::report::LadderProgress;
+use super::rules::{PAIRS_ABOVE, PAIR_FROM};
 use super::rung::{Fitted, Rung};
-use super::{Tried, PAIRS_ABOVE};
 use crate::analysis::{Analysis, AnalysisError};
 use crate::effects::EffectModel;
 use crate::explain::{explained_fraction, SkipReason, Skipped};
@@ -76,7 +78,7 @@ impl<'a> Ladder<'a> {
         let (an, rung) = (self.standing(), &self.rung);
         let kept = self.steps.len();
         let progress = |fraction: f64| {
-            (self.progress)(super::LadderProgress::Round {
+            (self.progress)(LadderProgress::Round {
                 round: kept + 1,
                 kept,
                 fraction,
@@ -258,7 +260,7 @@ fn full_order<'a>(
 }
 
 /// The pairs a round tries when no single candidate passes: every two of the
-/// [`super::PAIR_FROM`] single-effect candidates of `fitted` (plausible or not, not
+/// [`PAIR_FROM`] single-effect candidates of `fitted` (plausible or not, not
 /// diverged; fits of one round, the model's own `before` effects first in each) that
 /// lowered the training cost most, each pair's effects in the order fitted. A held-back
 /// error can rise with one effect of a pair and fall with both: with a start's cross
@@ -278,7 +280,7 @@ fn pairs_of<'a>(fitted: &[Fitted<'a>], before: usize) -> Vec<Vec<&'a dyn EffectM
     by_cost.sort_by(|a, b| a.fit.report.cost.total_cmp(&b.fit.report.cost));
     let top: Vec<Vec<&'a dyn EffectModel>> = by_cost
         .iter()
-        .take(super::PAIR_FROM)
+        .take(PAIR_FROM)
         .map(|c| c.models.iter().skip(before).copied().collect())
         .collect();
     let mut out = Vec::new();

@@ -1,0 +1,80 @@
+//! The ladder's rules, in numbers: the test a step passes, the noise-floor band it stops
+//! within, how finely the held-back split cuts the log, how many samples its fits run on,
+//! and how a round narrows its candidates.
+//!
+//! # The held-back split
+//! The log is cut into strata by its events ([`crate::strata::strata`]: the start, supply
+//! or speed transients, load moves, steady stretches), and every stratum into an even
+//! number of alternating windows ([`super::split::stratified_heldback`]), so that each kind of
+//! event the log holds falls in both the fitted and the held-back part. A fixed
+//! interleave of the whole log can put a log's only load step in the fitted part and leave
+//! the held-back windows blind to the effect that explains it.
+//!
+//! # The test a step passes
+//! A step is kept when the candidate removes at least [`STEP_MIN`] (10 %) of the held-back
+//! error beyond the noise floor that the model had before the step
+//! ([`crate::explain::explained_fraction`], each parameter costing [`crate::explain::PARAM_PENALTY`] of the
+//! held-back error), and lowers the whole-log error. The held-back error is an
+//! out-of-sample estimate: a candidate that only fits noise does not lower it, and one that
+//! absorbs another effect lowers it less than the effect itself. An information criterion
+//! (AIC, BIC) would count each of the log's 10⁴-10⁶ samples as an independent observation,
+//! while a model's error is structural and correlated over whole events: every candidate
+//! would pass. The threshold is the largest share a candidate without effect removed on the
+//! effect-free control logs of the test matrix (a textbook machine written inside the test,
+//! three sizes, starts and steps: under 10 %), doubled (docs/model-vs-measurement.md).
+
+use crate::explain::NOISE_MARGIN;
+
+/// A step must remove at least this share (10 %) of the held-back error beyond the noise
+/// floor that the model had before it (this module's doc, "The test a step passes").
+pub const STEP_MIN: f64 = 0.1;
+/// The noise-floor band: an error within this factor of its noise floor, on the whole log
+/// and on the held-back part, has nothing left to explain (the same margin as
+/// [`NOISE_MARGIN`]: a model error beyond the noise of half the noise floor).
+pub const FLOOR_BAND: f64 = NOISE_MARGIN;
+/// Longest held-back or fitted window of a stratum [s] before it is cut further: a steady
+/// stretch is interleaved at least this finely.
+pub const WINDOW_MAX_S: f64 = 0.5;
+/// Longest window of an event's stratum (a start, a transient, a load move) [s]: an event
+/// is interleaved finely, so that its fastest part (a start's acceleration) is in both
+/// parts.
+pub const EVENT_WINDOW_MAX_S: f64 = 0.08;
+/// Largest number of samples a ladder's fit simulates (a longer log is fitted on a coarser
+/// copy and measured on the working series). A third of explain's
+/// ([`crate::MAX_FIT_SAMPLES`]): a round fits every candidate, a ladder has several rounds,
+/// and a few parameters are fitted as well from 20 000 samples (a 10 s log at 2 kHz still
+/// resolves the stator transient time constant, 3 samples or more of it: the dynamics
+/// effects are refused on a series that does not, [`crate::transients::not_proposed`]).
+pub const LADDER_FIT_SAMPLES: usize = 20_000;
+/// Largest fit copy of a long log whose dynamics need more samples than
+/// [`LADDER_FIT_SAMPLES`] ([`super::rung::fit_thinning`]): three times as many (a 60 s log at 2 kHz at
+/// 1 kHz), beyond which the copy is thinned to this size and the dynamics effects are
+/// refused as unresolved.
+pub const LADDER_MAX_FIT_SAMPLES: usize = 60_000;
+/// Iterations of a round's screening fit of every candidate (`round/`): enough to rank
+/// them; the [`FINALISTS`] best are then fitted in full.
+pub const SCREEN_ITER: usize = 6;
+/// How many screened candidates of a round are fitted in full (plus the best by held-back
+/// error alone when it is not among them).
+pub const FINALISTS: usize = 3;
+/// Pairs are tried only while the held-back error is above this multiple (2) of its noise
+/// floor: two effects that need each other leave a large error alone (the windage
+/// scenario's flux dynamics and load torque, 65x the floor without them); near the floor a
+/// pair's test would weigh two effects' worth of parameters against a few per cent of noise,
+/// and the round took 40 % of a ladder's time.
+pub const PAIRS_ABOVE: f64 = 2.0;
+/// How many single candidates the pair search pairs: those that lowered the training cost
+/// most. With 3 the windage scenario's second step (flux dynamics with a load torque, the
+/// fourth single of its round) is not found and the ladder stops at 65x its floor.
+pub const PAIR_FROM: usize = 4;
+/// Supply periods in the shortest window of a stratum (an event's stratum is cut into two
+/// windows at least, each this long where the event allows).
+pub const WINDOW_MIN_PERIODS: f64 = 2.0;
+/// A refitted base parameter that differs from the file's by less than this (3 %) is not a
+/// change the ladder names, whatever its interval.
+pub const BASE_CHANGE_MIN: f64 = 0.03;
+
+/// How much more error beyond the noise floor the one law may leave than the pair (and a
+/// confusable partner than the chosen effect, `apart.rs`) and still be said to fit the log
+/// as well (10 %: the pair's two parameters against the one law's two, on the same fit).
+pub const AS_ONE_WITHIN: f64 = 0.10;
