@@ -373,3 +373,50 @@ fn a_constant_torque_and_dry_friction_on_a_shaft_that_never_reverses_are_said_al
         j["final_fit"]["alike"]
     );
 }
+
+/// One story across commands (the motulator log past its start): the load step at 2.5 s
+/// takes the light 2.2 kW shaft from no load to its rated torque in about 10 ms, against a
+/// rotor time constant of 107 ms, so the machine's dynamics act on it. The ladder adds them
+/// (they remove most of what the load torque leaves), and `explain` on the same span ranks
+/// them too instead of skipping them as having "nothing to act on".
+#[test]
+fn explain_and_the_ladder_agree_that_a_fast_load_step_moves_the_dynamics() {
+    let (p, log) = motulator();
+    let lad = ladder(&["--json", "--from", "0.8"], &p, &log);
+    assert!(lad.status.success());
+    let lad: serde_json::Value = serde_json::from_slice(&lad.stdout).unwrap();
+    let added: Vec<String> = lad["final_effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|e| e.as_str())
+        .filter(|e| e.ends_with("_dynamics"))
+        .map(str::to_string)
+        .collect();
+    assert!(added.len() >= 2, "the ladder's dynamics: {added:?}");
+    let ex = Command::cargo_bin("sim-host")
+        .unwrap()
+        .args(["explain", "--json", "--from", "0.8", "--params"])
+        .arg(&p)
+        .arg(&log)
+        .output()
+        .unwrap();
+    assert!(ex.status.success());
+    let ex: serde_json::Value = serde_json::from_slice(&ex.stdout).unwrap();
+    let no_transient: Vec<&serde_json::Value> = ex["skipped_reasons"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|s| s["because"]["why"].get("no_transient").is_some())
+        .collect();
+    assert!(no_transient.is_empty(), "explain skips: {no_transient:?}");
+    let ranked: Vec<&str> = ex["ranking"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|r| r["effect"].as_str())
+        .collect();
+    for d in ["flux_dynamics", "d_axis_dynamics"] {
+        assert!(ranked.contains(&d), "{d} not ranked: {ranked:?}");
+    }
+}

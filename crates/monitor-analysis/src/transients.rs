@@ -219,23 +219,32 @@ pub enum NotProposed {
         /// The effect's time constant [s].
         tau_s: f64,
     },
-    /// A dynamics effect (time constant `tau_s` [s]) on a log without a start or a supply
-    /// step (voltage and frequency within [`STEP_MIN`]).
+    /// A dynamics effect (time constant `tau_s` [s]) on a log without a start, a supply
+    /// step (voltage and frequency within [`STEP_MIN`]) or a fast speed change (within
+    /// [`SPEED_CHANGE_MIN`] of the synchronous speed over [`settling_s`],
+    /// [`speed_transient`]).
     NoTransient {
         /// The effect's time constant [s].
         tau_s: f64,
+        /// The window a speed change is judged over ([`settling_s`]) [s].
+        settling_s: f64,
     },
 }
 
 /// What the analysed span offers an effect with a time constant: the sample period of the
-/// series the fits run on (a long log's coarse copy) and whether that series holds a
-/// transient of the model's inputs ([`input_transients`]).
+/// series the fits run on (a long log's coarse copy), whether that series holds a
+/// transient of the model's inputs ([`input_transients`]) and whether its speed moves
+/// faster than the rotor's flux settles ([`speed_transient`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Span {
     /// Sample period of the fit series [s].
     pub dt_s: f64,
     /// Whether it holds a start or a supply step.
     pub input_transient: bool,
+    /// Whether its speed moves by more than [`SPEED_CHANGE_MIN`] of the synchronous speed
+    /// within [`settling_s`] (a load step on a machine whose shaft is light against its
+    /// rotor time constant).
+    pub speed_change: bool,
 }
 
 impl Span {
@@ -244,18 +253,40 @@ impl Span {
         Span {
             dt_s: fit_series.dt_s,
             input_transient: input_transients(fit_series, n).iter().any(|&t| t),
+            speed_change: speed_transient(fit_series, n),
         }
     }
+}
+
+/// Whether the measured speed of `d` moves by more than [`SPEED_CHANGE_MIN`] of the
+/// synchronous speed within any [`settling_s`] of the log (false without a speed column).
+/// Such a move is a transient the electrical dynamics act on: the rotor's flux and the
+/// currents settle over the rotor time constant `Lr / Rr`, and a load step moves a light
+/// shaft faster than that (motulator's 2.2 kW machine takes its rated torque from no load
+/// in about 10 ms, against a rotor time constant of 107 ms: the full-order machine then
+/// removes 98 % of the error a load torque leaves). A move spread over more than the
+/// settling time stays quasi-static and is not counted.
+pub fn speed_transient(d: &Prepared, n: &MachineConstants) -> bool {
+    let len = d.len();
+    if !d.channels.speed || d.omega_r.len() != len || len < 2 {
+        return false;
+    }
+    let look = ((settling_s(n) / d.dt_s.max(1e-9)).ceil() as usize).max(1);
+    let ws = super::effects::sync_speed_mech(d, n) * n.np;
+    sliding_span(&d.omega_r, look)
+        .into_iter()
+        .any(|(lo, hi, _)| (hi - lo) / ws > SPEED_CHANGE_MIN)
 }
 
 /// The one rule for whether effect `e` is proposed on a span (`None`: it is), with the
 /// model holding `in_model`: for a dynamics effect (one that declares a time constant,
 /// [`EffectModel::time_constant_s`]), its time constant is shorter than 3 samples of the
-/// (coarse) fit series of a long log, or the span holds no transient of the model's inputs
-/// for its dynamics to act on (said first: then no rung of the dynamics ladder is
-/// proposed); else an effect it needs first ([`EffectModel::requires`]) is missing. Without a start or a supply step the electrical states
-/// follow the inputs quasi-statically (a load step moves the speed at the mechanical
-/// rate), the full-order machine's steady state is the paper's model, and what a dynamics
+/// (coarse) fit series of a long log, or the span holds no transient for its dynamics to
+/// act on (said first: then no rung of the dynamics ladder is proposed): no start, no
+/// supply step, no speed change faster than the rotor's flux settles
+/// ([`speed_transient`]); else an effect it needs first ([`EffectModel::requires`]) is
+/// missing. Without any of these the electrical states follow the inputs quasi-statically,
+/// the full-order machine's steady state is the paper's model, and what a dynamics
 /// effect's extra states gain there they gain by absorbing another effect
 /// (docs/model-vs-measurement.md, "How it works"). `explain` skips such an effect with
 /// this reason; `compare`'s advice prints the same ([`dynamics_plan`]).
@@ -272,8 +303,11 @@ pub fn not_proposed(
                 tau_s,
             });
         }
-        if !span.input_transient {
-            return Some(NotProposed::NoTransient { tau_s });
+        if !span.input_transient && !span.speed_change {
+            return Some(NotProposed::NoTransient {
+                tau_s,
+                settling_s: settling_s(n),
+            });
         }
     }
     let missing: Vec<EffectId> = e
@@ -453,8 +487,8 @@ fn cover(plan: &[(EffectId, Option<NotProposed>)], in_model: &[EffectId]) -> Cov
 /// [`settling_s`] after the direct-on-line start ends ([`start_end_s`]), or where the
 /// supply voltage amplitude or the supply frequency spans more than [`STEP_MIN`] of its
 /// mean over the [`settling_s`] before the sample (the same test as a `supply_step` window
-/// of [`classify`]). A load step is not an input transient: the speed moves at the
-/// mechanical rate and the electrical states follow it quasi-statically.
+/// of [`classify`]). A load step is not an input transient (the model's inputs are the
+/// supply); where it moves the speed fast, [`speed_transient`] says so.
 pub fn input_transients(d: &Prepared, n: &MachineConstants) -> Vec<bool> {
     let len = d.len();
     let look = ((settling_s(n) / d.dt_s.max(1e-9)).ceil() as usize).max(1);
@@ -518,7 +552,47 @@ fn sliding_span(x: &[f64], w: usize) -> Vec<(f64, f64, f64)> {
 
 #[cfg(test)]
 mod tests {
-    use super::sliding_span;
+    use super::{settling_s, sliding_span, speed_transient, SPEED_CHANGE_MIN};
+    use crate::prep::Prepared;
+    use crate::simplified_model::MachineConstants;
+    use monitor_io::params::ParamFile;
+
+    /// A 2 kHz log of `secs` on a 50 Hz supply whose electrical speed runs along `w(t)`.
+    fn log_with_speed(secs: f64, w: impl Fn(f64) -> f64) -> Prepared {
+        let dt = 5e-4;
+        let len = (secs / dt) as usize;
+        let t_s: Vec<f64> = (0..len).map(|k| k as f64 * dt).collect();
+        let mut d = Prepared {
+            omega_r: t_s.iter().map(|&t| w(t)).collect(),
+            omega_s: vec![std::f64::consts::TAU * 50.0; len],
+            t_s,
+            dt_s: dt,
+            ..Default::default()
+        };
+        d.channels.speed = true;
+        d
+    }
+
+    /// A load step that slows the shaft by 4.4 % of synchronous speed (motulator's 2.2 kW
+    /// machine, no load to rated) within 10 ms is a transient for the flux; the same fall
+    /// spread over three settling times, or a fall of half the threshold at once, is not;
+    /// nor is a log without a speed column.
+    #[test]
+    fn a_fast_speed_change_is_a_transient_and_a_slow_one_is_not() {
+        let n = MachineConstants::from_params(&ParamFile::reference_2p2kw());
+        let ws = std::f64::consts::TAU * 50.0;
+        let fall = 0.044 * ws;
+        let step = |t: f64| ws - fall * ((t - 1.0) / 0.01).clamp(0.0, 1.0);
+        assert!(speed_transient(&log_with_speed(3.0, step), &n));
+        let ramp_s = 3.0 * settling_s(&n);
+        let ramp = |t: f64| ws - fall * ((t - 0.5) / ramp_s).clamp(0.0, 1.0);
+        assert!(!speed_transient(&log_with_speed(1.0 + ramp_s, ramp), &n));
+        let small = |t: f64| ws - 0.5 * SPEED_CHANGE_MIN * ws * ((t - 1.0) / 0.01).clamp(0.0, 1.0);
+        assert!(!speed_transient(&log_with_speed(3.0, small), &n));
+        let mut blind = log_with_speed(3.0, step);
+        blind.channels.speed = false;
+        assert!(!speed_transient(&blind, &n));
+    }
 
     #[test]
     fn sliding_span_matches_a_direct_computation() {

@@ -5,7 +5,7 @@
 use crate::Spelling;
 use monitor_analysis::effects::SetupError;
 use monitor_analysis::explain::{SkipReason, Skipped};
-use monitor_analysis::transients::{NotProposed, STEP_MIN};
+use monitor_analysis::transients::{NotProposed, SPEED_CHANGE_MIN, STEP_MIN};
 use monitor_analysis::unbalance::{CannotJudgeUnbalance, UnbalanceAnalysis, UnbalanceFinding};
 use monitor_analysis::EffectId;
 use monitor_replay::OptionField;
@@ -53,9 +53,11 @@ pub fn not_proposed(n: &NotProposed, spell: &dyn Spelling) -> String {
             spell.hint(OptionField::From, ""),
             spell.hint(OptionField::To, "")
         ),
-        NotProposed::NoTransient { tau_s } => format!(
-            "no start or supply step in the analysed span (voltage and frequency within {:.0} %): its {:.1} ms dynamics have nothing to act on",
+        NotProposed::NoTransient { tau_s, settling_s } => format!(
+            "no start, supply step or fast speed change in the analysed span (voltage and frequency within {:.0} %, the speed within {:.0} % of synchronous over {:.0} ms): its {:.1} ms dynamics have nothing to act on",
             100.0 * STEP_MIN,
+            100.0 * SPEED_CHANGE_MIN,
+            1000.0 * settling_s,
             1000.0 * tau_s
         ),
     }
