@@ -330,9 +330,10 @@ fn out_of_range_values_print_their_unit_and_no_unit_one() {
 /// that effect (issue 62: `cross_coupling_dynamics` with `d_axis_dynamics`, the full-order
 /// machine; judged against the model alone it was dropped from the advice and nothing
 /// proposed it later); every other one the advice adds is one `explain` fitted. On the
-/// motulator log (a start and a load step), a simulated start, and a simulated load step
-/// without a start (no input transient: the advice adds nothing and says why, as `explain`
-/// does).
+/// motulator log (a start and a load step), a simulated start, and simulated load steps
+/// without a start that move the speed fast (the advice adds the dynamics, and `explain`
+/// fits them; a log whose speed moves little skips them with the reason:
+/// `analysis_effects`' `dynamics_effects_need_an_input_transient`).
 #[test]
 fn compare_advice_and_explain_skipped_agree() {
     let dir = tempfile::tempdir().unwrap();
@@ -373,6 +374,13 @@ fn compare_advice_and_explain_skipped_agree() {
         ),
     ];
     for (case, a, start) in cases {
+        // The load steps of 16 N m, more than the 3 hp motor's rated torque, move the speed
+        // by several per cent of synchronous speed within a few ms: a transient the
+        // dynamics act on (`transients::speed_transient`), as a start is.
+        assert!(
+            monitor_analysis::transients::speed_transient(&a.data, &a.constants),
+            "{case}: the speed moves fast"
+        );
         let c = a.compare(&opts(&[])).unwrap().report;
         let ex = a.explain(&opts(&[]), &|_| {}).unwrap().report;
         let skipped: Vec<(EffectId, Option<&NotProposed>)> = ex
@@ -422,14 +430,7 @@ fn compare_advice_and_explain_skipped_agree() {
             // The full-order machine: all four dynamics effects advised on a start.
             assert_eq!(added.len(), 4, "{case}: {added:?}");
         }
-        assert_eq!(!added.is_empty(), start, "{case}: {added:?}");
-        if !start {
-            assert!(
-                held.iter()
-                    .any(|s| matches!(s.1, Some(NotProposed::NoTransient { .. }))),
-                "{case}: {held:?}"
-            );
-        }
+        assert!(!added.is_empty(), "{case}: {added:?}");
     }
 }
 
