@@ -52,6 +52,18 @@ fn the_ring_depth_follows_from_the_latency_budget() {
     assert!(samples_per_half_for(20_000) > 3);
 }
 
+/// The latch's ring keeps step with the ADCs' rings: TIM1's trigger latches one count per
+/// sequence, so a half of the latch's ring holds the triggers of a DMA half, three samples
+/// of eight (24), and the ring two such halves (48); a half of any other length hands the
+/// sample task counts of other triggers than its conversions'.
+#[test]
+fn the_latch_ring_holds_one_count_per_trigger_of_a_dma_half() {
+    assert_eq!(LATCH_HALF_LEN, 3 * 8);
+    assert_eq!(LATCH_LEN, 2 * 3 * 8);
+    assert_eq!(LATCH_HALF_LEN, DMA_HALF_LEN / CHANNELS);
+    assert_eq!(LATCH_HALF_LEN, SAMPLES_PER_HALF * OVERSAMPLING);
+}
+
 /// An inrush peak clipped on two of a sample's eight conversions: the mean is below
 /// the rail (the former check on the mean, `is_saturated_code`, passes it), the check of
 /// each conversion catches it; within the range nothing is flagged, at its edges both
@@ -349,4 +361,80 @@ fn the_average_nulls_multiples_of_the_sample_rate() {
         let avg = average_half(&half);
         assert!((i32::from(avg[0]) - 2048).abs() <= 1, "{f} Hz: {avg:?}");
     }
+}
+
+/// The task must keep up as well as the ring hold. A ring deeper than the smallest that
+/// holds holds too (10 kHz: 3 to 8 samples a half). A sample whose work takes its whole
+/// period, or more, fits no depth: the work at the lap case is 1 737 instructions x 2.6 =
+/// 4 516.2, 4 517 cycles; at 40 kHz a sample has 4 250 (the copy's latency is within the
+/// slack from 10 samples a half on, 39 257 against 42 717 cycles, the work is not), at
+/// 37 635 Hz exactly 4 517 (9 samples a half: 38 997 against 40 878).
+#[test]
+fn a_ring_fits_only_where_the_task_keeps_up() {
+    for k in 3..=8 {
+        assert!(ring_fits(10_000, k), "{k} samples a half at 10 kHz");
+    }
+    assert_eq!(lap_cycles(SAMPLE_WORK_INSTRUCTIONS), 4_517);
+    assert_eq!(sample_period_cycles(40_000), 4_250);
+    assert_eq!(lap_latency_cycles(10), 39_257);
+    assert_eq!(lap_slack_cycles(40_000, 10), 42_717);
+    for k in 1..=16 {
+        assert!(!ring_fits(40_000, k), "{k} samples a half at 40 kHz");
+    }
+    assert_eq!(samples_per_half_for(40_000), 8);
+    assert_eq!(sample_period_cycles(37_635), 4_517);
+    assert_eq!(lap_latency_cycles(9), 38_997);
+    assert_eq!(lap_slack_cycles(37_635, 9), 40_878);
+    assert!(
+        !ring_fits(37_635, 9),
+        "a sample's work takes its whole period"
+    );
+}
+
+/// The times that decide whether a sequence ends before the next trigger, from RM0440's
+/// cycles at the ADC clock of 170 MHz / 4 = 42.5 MHz: a sequence is three conversions of
+/// 24.5 + 12.5 = 37 cycles (3 x 870.6 ns, each rounded down: 2 610 ns); the injected
+/// VREFINT conversion 247.5 + 12.5 = 260 cycles (6 117.6 ns); a rate whose sequence held up
+/// by it ends after the next trigger does not fit.
+#[test]
+fn a_sequence_and_the_references_conversion_take_their_adc_cycles() {
+    let cycle_ns: f64 = 1e9 / 42.5e6;
+    let sequence = f64::from(sequence_ns());
+    assert!(
+        (sequence - 3.0 * (37.0 * cycle_ns).floor()).abs() < 0.5,
+        "{sequence} ns"
+    );
+    let reference = f64::from(reference_conversion_ns());
+    assert!((reference - 260.0 * cycle_ns).abs() < 1.0, "{reference} ns");
+    // 17 kHz: triggers at 136 kHz, 7 353 ns apart, a rate the timers' clock divides
+    // (1 250): longer than a sequence, shorter than one held up by VREFINT.
+    assert_eq!(crate::clock::timer_divider(17_000 * 8), Some(1_250));
+    assert!(!fits(17_000));
+    // No trigger, no sample.
+    assert!(!fits(0));
+}
+
+/// The builder's encoder check across a gap and a dropped sample, the shaft at 3 counts a
+/// trigger, 4 at most: after a gap in the triggers (a recovery) the shaft has moved on,
+/// 1 000 counts, and the builder restarted takes the first count after it as motion; a
+/// dropped sample's counts still go through the check, so the next sample's first step is
+/// one trigger's 3 counts, not the 27 of the dropped sample's triggers.
+#[test]
+fn a_gap_restarts_the_encoder_check_and_a_dropped_samples_counts_go_through_it() {
+    let codes = [2_048u16; HALF_LEN];
+    let run = |from: u16| -> [u16; OVERSAMPLING] {
+        core::array::from_fn(|k| from.wrapping_add(3 * k as u16))
+    };
+    let mut builder = SampleBuilder::new(10_000, 50.0, &LinearRanges::RAILS, 4);
+    assert_eq!(builder.build(&codes, &codes, &run(100)).encoder_rejects, 0);
+    builder.restart();
+    assert_eq!(
+        builder.build(&codes, &codes, &run(1_100)).encoder_rejects,
+        0
+    );
+    builder.skip(&run(1_124));
+    assert_eq!(
+        builder.build(&codes, &codes, &run(1_148)).encoder_rejects,
+        0
+    );
 }
