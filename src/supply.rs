@@ -505,4 +505,43 @@ mod tests {
         adc.converts = false;
         assert_eq!(measure_now(&mut adc), ReferenceCheck::Unreadable);
     }
+
+    /// RM0440's `BOR_LEV` thresholds (falling, about): 1.7, 2.0, 2.2, 2.5, 2.8 V, each level
+    /// higher than the one before; the goal's 2.8 V is below the NUCLEO's 3.3 V supply.
+    #[test]
+    fn each_brown_out_level_has_the_reference_manuals_threshold() {
+        let volts = BorLevel::ALL.map(BorLevel::falling_v);
+        assert_eq!(volts, [1.7, 2.0, 2.2, 2.5, 2.8]);
+        assert!(BOR_GOAL.falling_v() < 3.3);
+    }
+
+    /// A commissioning that ends with a measurement in hand puts its gain into force at
+    /// once: the readings scale with VDDA, so a VDDA 1.5 % below the commissioned one
+    /// (3.25 V against 3.30 V) gives a gain of 0.985 now, not one measurement later.
+    #[test]
+    fn a_commissioning_with_a_measurement_puts_its_gain_into_force() {
+        let mut gain = ReferenceGain::default();
+        let now = gain.commissioned(Some(3.30), Some(ReferenceCheck::InBand(3.25)));
+        let expected = 3.25 / 3.30;
+        assert!(now.is_some_and(|g| (g - expected).abs() < 1e-6), "{now:?}");
+        assert!((gain.in_force() - expected).abs() < 1e-6);
+    }
+
+    /// The gain follows VDDA beyond its deadband of 0.2 % only: 3.30 V commissioned, a
+    /// measurement of 3.2967 V (-0.1 %) changes nothing, one of 3.2868 V (-0.4 %) puts
+    /// 0.996 into force.
+    #[test]
+    fn the_gain_moves_only_beyond_its_deadband() {
+        let mut gain = ReferenceGain::default();
+        assert_eq!(gain.commissioned(Some(3.30), None), None);
+        assert_eq!(gain.commissioned_v(), Some(3.30));
+        assert_eq!(gain.observe(ReferenceCheck::InBand(3.2967)), None);
+        assert_eq!(gain.in_force(), 1.0);
+        let moved = gain.observe(ReferenceCheck::InBand(3.2868));
+        assert!(moved.is_some_and(|g| (g - 0.996).abs() < 1e-4), "{moved:?}");
+        assert!((gain.in_force() - 0.996).abs() < 1e-4);
+        // No commissioned VDDA: no correction, the gain back to 1.
+        assert_eq!(gain.commissioned(None, None), Some(1.0));
+        assert_eq!(gain.commissioned_v(), None);
+    }
 }
