@@ -31,7 +31,7 @@
 //! ```text
 //! MONITOR_FULL_SWEEPS=1 cargo test --release -p sim-host --test ladder_third_party -- --nocapture
 //! ```
-//! runs it (about 12 logs, one at a time; the table goes to stderr).
+//! runs it (14 logs, two of them 40 s long, one at a time; the table goes to stderr).
 #![allow(missing_docs)]
 
 use assert_cmd::Command;

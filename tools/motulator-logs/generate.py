@@ -491,6 +491,15 @@ LOGS = [
         "stator winding heats during the log (Rr unchanged)", 5.0, ["thermal_drift"],
         {}, bl_share=0.8, drift={"rise_k": 70.0, "tau_s": 3.0, "rotor": False},
         variac=[(2.5, 0.85), (3.5, 1.0)], seed=14),
+    Log("kw2p2_long_warming", "kw2p2", "a long log at 2 kHz: direct-on-line start, "
+        "viscous load 80 %, variac steps through 40 s; both windings warm by 50 K with a "
+        "15 s time constant", 40.0, ["thermal_drift"], {}, bl_share=0.8,
+        drift={"rise_k": 50.0, "tau_s": 15.0, "rotor": True},
+        variac=[(12.0, 0.9), (13.5, 1.0), (26.0, 1.05), (27.5, 1.0)], seed=18),
+    Log("kw2p2_long_control", "kw2p2", "the long log's control: direct-on-line start, "
+        "viscous load 80 %, variac steps through 40 s, the windings at the file's "
+        "temperature", 40.0, [], {}, bl_share=0.8,
+        variac=[(12.0, 0.9), (13.5, 1.0), (26.0, 1.05), (27.5, 1.0)], seed=19),
     Log("kw2p2_unbalance", "kw2p2", "direct-on-line start, viscous load 80 %, variac "
         "steps, a negative-sequence supply", 4.0, ["supply_unbalance"], {},
         variac=variac(0.6), bl_share=0.8, unbalance=(0.03, -40.0), seed=15),
