@@ -4,7 +4,8 @@
 //! and the ladder ends within 2x the noise floor.
 //!
 //! `cargo test` runs the two scenarios whose effect shows only where the speed moves
-//! (windage, Coulomb friction); `MONITOR_FULL_SWEEPS=1` runs all nine:
+//! (windage, Coulomb friction); `MONITOR_FULL_SWEEPS=1` runs all nine, and a long log at a
+//! low rate (40 s at 2 kHz of a small machine warming, with its control):
 //! ```text
 //! MONITOR_FULL_SWEEPS=1 cargo test --release -p sim-host --test ladder_scenarios -- --nocapture
 //! ```
@@ -29,30 +30,37 @@ fn params_of(scenario: &Path) -> PathBuf {
 }
 
 /// Simulates `effect_<effect>.toml` and runs the ladder on it: the JSON document.
-fn ladder_on(effect: &str, dir: &Path) -> serde_json::Value {
+fn ladder_on_scenario(effect: &str, dir: &Path) -> serde_json::Value {
     let scenario = repo().join(format!("examples/scenarios/effect_{effect}.toml"));
     let params = params_of(&scenario);
     let log = dir.join(format!("{effect}.csv"));
+    simulate_and_climb(&params, &scenario, &log, "0")
+}
+
+/// `simulate` of `scenario` on the machine of `params` into `log`, then `explain --ladder
+/// --json` on it from `from` s: the JSON document.
+fn simulate_and_climb(params: &Path, scenario: &Path, log: &Path, from: &str) -> serde_json::Value {
     Command::cargo_bin("sim-host")
         .unwrap()
         .args(["simulate", "--params"])
-        .arg(&params)
+        .arg(params)
         .arg("--scenario")
-        .arg(&scenario)
+        .arg(scenario)
         .arg("--out")
-        .arg(&log)
+        .arg(log)
         .assert()
         .success();
     let out = Command::cargo_bin("sim-host")
         .unwrap()
-        .args(["explain", "--ladder", "--json", "--params"])
-        .arg(&params)
-        .arg(&log)
+        .args(["explain", "--ladder", "--json", "--from", from, "--params"])
+        .arg(params)
+        .arg(log)
         .output()
         .unwrap();
     assert!(
         out.status.success(),
-        "{effect}: {}",
+        "{}: {}",
+        scenario.display(),
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).unwrap()
@@ -63,7 +71,7 @@ fn ladder_on(effect: &str, dir: &Path) -> serde_json::Value {
 /// is met within 10 % when given.
 fn named(effect: &str, truth: Option<(&str, f64)>) {
     let dir = tempfile::tempdir().unwrap();
-    let v = ladder_on(effect, dir.path());
+    let v = ladder_on_scenario(effect, dir.path());
     let steps = v["ladder"].as_array().unwrap();
     let added = |s: &serde_json::Value| -> Vec<String> {
         let a = s["added"].as_array().unwrap();
@@ -134,4 +142,180 @@ fn every_other_hidden_effect_is_named() {
     ] {
         named(e, None);
     }
+}
+
+/// The long low-rate log's scenario: a machine started direct-on-line on its viscous
+/// load, 40 s at 2 kHz (80 000 samples), variac steps through the run, a 12-bit current
+/// sensor of range `i_range_a` with `noise_i` A of noise; `warming`: both windings warm by
+/// 50 K with a 15 s time constant.
+fn long_scenario(warming: bool, i_range_a: f64, noise_i: f64) -> String {
+    let mut s = format!(
+        r#"duration_s = 40.0
+sample_rate_hz = 2000.0
+seed = 5
+
+[supply]
+steps = [{{ t_s = 12.0, v_scale = 0.9 }}, {{ t_s = 13.5, v_scale = 1.0 }}, {{ t_s = 26.0, v_scale = 1.05 }}, {{ t_s = 27.5, v_scale = 1.0 }}]
+
+[load]
+kind = "viscous"
+
+[sensors]
+adc_bits = 12
+v_range_v = 400.0
+i_range_a = {i_range_a}
+noise_v = 0.5
+noise_i = {noise_i}
+encoder = false
+"#
+    );
+    if warming {
+        s.push_str(
+            "\n[[effects]]\nname = \"thermal_drift\"\nrise_k = 50.0\ntau_s = 15.0\nrotor = true\n",
+        );
+    }
+    s
+}
+
+/// A long log of [`long_scenario`] on the machine of `machine` (the file the simulator and
+/// the analysis read), the ladder's JSON from `from` s on.
+struct LongLog<'a> {
+    machine: monitor_io::params::ParamFile,
+    i_range_a: f64,
+    noise_i: f64,
+    from: &'a str,
+}
+
+/// The 0.37 kW machine (`monitor_testkit::small_motor`, a 2.1 ms stator transient), from
+/// 0.3 s on: the span `compare` advises, this machine reaching its speed in 30 ms, a start
+/// the library's model does not follow (docs/model-vs-measurement.md).
+fn small_long() -> LongLog<'static> {
+    LongLog {
+        machine: monitor_testkit::small_motor::small_0p37kw(),
+        i_range_a: 10.0,
+        noise_i: 0.002,
+        from: "0.3",
+    }
+}
+
+/// The ladder's JSON on the 0.37 kW machine's long log ([`small_long`]).
+fn ladder_on_long_log(warming: bool, dir: &Path) -> serde_json::Value {
+    ladder_on(&small_long(), warming, dir)
+}
+
+/// Simulates the long log of `l` (warming or not) into `dir` and runs the ladder on it
+/// from `l.from`: the JSON document.
+fn ladder_on(l: &LongLog<'_>, warming: bool, dir: &Path) -> serde_json::Value {
+    let params = dir.join("machine.toml");
+    let scenario = dir.join("long.toml");
+    let log = dir.join("long.csv");
+    std::fs::write(&params, l.machine.to_toml_string()).unwrap();
+    std::fs::write(&scenario, long_scenario(warming, l.i_range_a, l.noise_i)).unwrap();
+    simulate_and_climb(&params, &scenario, &log, l.from)
+}
+
+/// A long log at a low rate (issue 87): 40 s at 2 kHz of a small machine warming by 50 K.
+/// The fit keeps the log's own rate, which the machine's 2.1 ms stator transient needs (at
+/// 1 kHz its dynamics were refused and the ladder stopped at 11x the floor, "nothing
+/// plausible helps", warming or not): the drift is named with both windings' rise within
+/// 25 % of the injected 50 K beside the machine's dynamics, the chosen model refitted on
+/// the whole log ends within 1.2x the floor, and the same log without the warming names no
+/// drift. Full sweeps only (two ladders of 80 000 samples).
+#[test]
+fn a_long_low_rate_log_names_its_warming_and_its_control_stays_clean() {
+    if !full() {
+        return;
+    }
+    let finals = |v: &serde_json::Value| -> Vec<String> {
+        v["final_effects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e.as_str().unwrap().to_string())
+            .collect()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let v = ladder_on_long_log(true, dir.path());
+    let fin = &v["final_fit"];
+    let drift = fin["fitted"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["effect"] == "thermal_drift")
+        .unwrap_or_else(|| panic!("no drift named: {:?}", finals(&v)));
+    for p in ["stator_rise_k", "rotor_rise_k"] {
+        let rise = drift["parameters"][p]["value"].as_f64().unwrap();
+        assert!(
+            (rise - 50.0).abs() <= 12.5,
+            "{p} {rise:.1} K, injected 50 K"
+        );
+    }
+    let dynamics = finals(&v).iter().any(|e| e.ends_with("_dynamics"));
+    assert!(dynamics, "the dynamics refused: {:?}", finals(&v));
+    let end = fin["ratio_to_floor"].as_f64().unwrap();
+    assert!(end <= 1.2, "the warming log ends at {end:.2}x the floor");
+    let c = ladder_on_long_log(false, dir.path());
+    let named = finals(&c);
+    assert!(
+        named.iter().all(|e| e.ends_with("_dynamics")),
+        "the control names {named:?}"
+    );
+    let end = c["final_fit"]["ratio_to_floor"].as_f64().unwrap();
+    assert!(end <= 1.2, "the control ends at {end:.2}x the floor");
+}
+
+/// The stopping rule weighs the log's length (issue 87): 40 s at 60 Hz of the 3 hp machine
+/// (2 400 supply periods) warming by 50 K ends at 1.04x the floor with the dynamics alone,
+/// inside the 1.12x band of a short log, where the ladder said "nothing is left to
+/// explain" and never tried the drift. Its band is now 1.03x: the drift is tried (named,
+/// or refused with its reason). The same log without the warming still stops at the floor
+/// with the dynamics only. Full sweeps only.
+#[test]
+fn a_long_log_tries_an_effect_below_the_short_logs_band() {
+    if !full() {
+        return;
+    }
+    let three_hp = LongLog {
+        machine: monitor_io::params::ParamFile::reference_3hp(),
+        i_range_a: 200.0,
+        noise_i: 0.05,
+        from: "0",
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let added = |s: &serde_json::Value| -> Vec<String> {
+        s["added"]
+            .as_array()
+            .map(|a| a.iter().map(|e| e.as_str().unwrap().to_string()).collect())
+            .unwrap_or_default()
+    };
+    let v = ladder_on(&three_hp, true, dir.path());
+    let named = v["ladder"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|s| added(s).iter().any(|e| e == "thermal_drift"));
+    // Tried on its own in the round after the dynamics: refused for a reason of its own,
+    // not because a better candidate was kept (the round that added the dynamics).
+    let judged = v["last_round"].as_array().unwrap().iter().any(|t| {
+        added(t).iter().any(|e| e == "thermal_drift") && t["refusal"]["kind"] != "better_kept"
+    });
+    assert!(
+        named || judged,
+        "the drift never judged on its own: stopped {}",
+        v["stopped_because"]
+    );
+    let band = v["test_rule"]["floor_band"].as_f64().unwrap();
+    assert!(band < 1.05, "band {band}");
+    let c = ladder_on(&three_hp, false, dir.path());
+    assert_eq!(c["stop"], "noise_floor", "{}", c["stopped_because"]);
+    let named: Vec<String> = c["final_effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e.as_str().unwrap().to_string())
+        .collect();
+    assert!(
+        named.iter().all(|e| e.ends_with("_dynamics")),
+        "the control names {named:?}"
+    );
 }

@@ -8,7 +8,7 @@ use crate::Spelling;
 use monitor_analysis::effects::{sig, ApartBy, ALPHA_CU_PER_K};
 use monitor_analysis::explain::ladder::{
     Alike, AsOne, BaseChange, FinalFit, LadderReport, LadderStep, NotSeparable, Refusal,
-    StopReason, TestRule, Tried, WhatIsLeft, WhyNotPhysical,
+    StopReason, TestRule, Tried, WhatIsLeft, WhyNotPhysical, BAND_PERIODS, FLOOR_BAND,
 };
 use monitor_analysis::fit::machine::BaseKey;
 use serde_json::Value;
@@ -62,7 +62,7 @@ pub fn stopped(r: &LadderReport) -> String {
             heldback_noise_floor,
             band,
         } => format!(
-            "at the noise floor: the whole-log error {} is {:.2}x its noise floor {} and the held-back error {} is {:.2}x its floor {} (both within {band}x): nothing is left to explain",
+            "at the noise floor: the whole-log error {} is {:.2}x its noise floor {} and the held-back error {} is {:.2}x its floor {} (both within {band:.2}x): nothing is left to explain",
             sig(*error),
             error / noise_floor,
             sig(*noise_floor),
@@ -194,10 +194,17 @@ pub fn tried_name(t: &Tried) -> String {
 /// The rule each step passed and the ladder stops by (JSON `test`).
 pub fn test(rule: &TestRule) -> String {
     format!(
-        "a step is kept when it removes at least {:.0} % of the held-back error beyond the noise floor (each parameter costing {:.0} % of the held-back error) and lowers the whole-log error; the ladder stops within {}x the noise floor on the whole log and the held-back part",
+        "a step is kept when it removes at least {:.0} % of the held-back error beyond the noise floor (each parameter costing {:.0} % of the held-back error) and lowers the whole-log error; the ladder stops within {:.2}x the noise floor on the whole log and the held-back part{}",
         100.0 * rule.step_min,
         100.0 * rule.param_penalty,
-        rule.floor_band
+        rule.floor_band,
+        if rule.floor_band < FLOOR_BAND - 1e-9 {
+            format!(
+                " ({FLOOR_BAND:.2}x on a log of up to {BAND_PERIODS:.0} supply periods; this log's periods show a smaller model error)"
+            )
+        } else {
+            String::new()
+        }
     )
 }
 

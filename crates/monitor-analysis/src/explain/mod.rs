@@ -140,9 +140,16 @@ pub const HOLDOUT_WINDOWS: usize = 8;
 /// half the noise floor (the baseline within [`NOISE_MARGIN`] of it) there is nothing to
 /// explain and the fraction is 0: a ratio of two noise-sized numbers means nothing.
 pub fn explained_fraction(e_base: f64, e_with: f64, noise: f64) -> f64 {
+    explained_fraction_beyond(e_base, e_with, noise, 0.5)
+}
+
+/// [`explained_fraction`] with `excess` (in units of the noise floor) as the least model
+/// error beyond the noise there is to explain: below `excess * noise` the fraction is 0.
+/// The ladder's band narrows it on a long log ([`ladder::FloorBand`]).
+pub fn explained_fraction_beyond(e_base: f64, e_with: f64, noise: f64, excess: f64) -> f64 {
     let s = |e: f64| (e * e - noise * noise).max(0.0).sqrt();
     let sb = s(e_base);
-    if sb <= 0.0 || sb < 0.5 * noise {
+    if sb <= 0.0 || sb < excess * noise {
         return 0.0;
     }
     (1.0 - s(e_with) / sb).clamp(0.0, 1.0)

@@ -15,7 +15,7 @@
 //! load laws of its model, with the base parameters free as in the final fit. Where that
 //! one law of two parameters explains the log as well as the pair (its error beyond the
 //! noise floor at most [`AS_ONE_WITHIN`] more than the pair's, or within the band the ladder
-//! stops in, [`FLOOR_BAND`]), the pair is reported as one
+//! stops in, [`super::rules::FLOOR_BAND`]), the pair is reported as one
 //! ([`AsOne`]), with the exponent the log shows and the torque at synchronous speed: the
 //! law a user writes (`--laws`) when the library lacks it. A pair the one law cannot
 //! follow (a constant load beside a fan over a start: the load at standstill is no power
@@ -32,7 +32,7 @@
 
 use super::climb::Ladder;
 use super::report::{Alike, AsOne};
-use super::rules::{AS_ONE_WITHIN, FLOOR_BAND};
+use super::rules::AS_ONE_WITHIN;
 use super::rung::nested_from;
 use crate::analysis::{Analysis, AnalysisError, FittedEffect};
 use crate::effects::{sync_speed_mech, EffectModel, LawEffect};
@@ -46,13 +46,13 @@ const EXPONENT_MARGIN: f64 = 0.05;
 
 /// True when a model whose whole-log error is `e` fits the log as well as one at `error`
 /// (both over the floor `noise`): its error beyond the floor at most [`AS_ONE_WITHIN`]
-/// more, or within the band the ladder stops in ([`FLOOR_BAND`]): at the floor the
-/// log cannot choose (kw7p5_coulomb: 1.02x with dry friction, 1.023x with a constant torque
-/// in its place, 28 % more of a sliver beyond the floor).
-fn as_well(e: f64, error: f64, noise: f64) -> bool {
+/// more, or within the band the ladder stops in (`band`, [`super::rules::FLOOR_BAND`] on a log of up to
+/// [`super::rules::BAND_PERIODS`] supply periods): at the floor the log cannot choose
+/// (kw7p5_coulomb: 1.02x with dry friction, 1.023x with a constant torque in its place, 28 %
+/// more of a sliver beyond the floor).
+fn as_well(e: f64, error: f64, noise: f64, band: f64) -> bool {
     e.is_finite()
-        && ((e - noise) <= (1.0 + AS_ONE_WITHIN) * (error - noise).max(0.0)
-            || e / noise <= FLOOR_BAND)
+        && ((e - noise) <= (1.0 + AS_ONE_WITHIN) * (error - noise).max(0.0) || e / noise <= band)
 }
 
 impl Ladder<'_> {
@@ -133,7 +133,7 @@ impl Ladder<'_> {
                     .iter()
                     .find(|e| e.effect == conf.with)
                     .is_some_and(|e| e.plausible);
-                if plausible && as_well(e, error, noise) {
+                if plausible && as_well(e, error, noise, self.series.band.ratio) {
                     out.push(Alike {
                         effect: m.kind(),
                         other: conf.with,
@@ -193,7 +193,7 @@ impl Ladder<'_> {
                     continue;
                 };
                 let reading = *n > EXPONENT_MARGIN && *n < 5.0 - EXPONENT_MARGIN;
-                if reading && as_well(e, error, noise) {
+                if reading && as_well(e, error, noise, self.series.band.ratio) {
                     out.push(AsOne {
                         effects: [models[i].kind(), models[j].kind()],
                         exponent: *n,

@@ -7,7 +7,6 @@
 use super::refusal::Tried;
 use super::refusal::{StopReason, WhatIsLeft};
 use super::report::{LadderProgress, LadderReport, LadderStart, LadderStep};
-use super::rules::FLOOR_BAND;
 use super::rung::{LadderSeries, Rung};
 use crate::analysis::{Analysis, AnalysisError, Options};
 use crate::effects::EffectModel;
@@ -215,15 +214,18 @@ impl<'a> Ladder<'a> {
 }
 
 /// Why the ladder stops at `rung` for the noise floor, if it does: both the whole-log and
-/// the held-back error within [`FLOOR_BAND`] of their floors.
+/// the held-back error within the log's band of their floors ([`super::rules::FLOOR_BAND`] on a log of
+/// up to [`super::rules::BAND_PERIODS`] supply periods, narrower beyond:
+/// [`super::rules::FloorBand`]).
 fn at_floor(rung: &Rung<'_>) -> Option<StopReason> {
     let r = rung.error / rung.noise;
     let rh = rung.heldback_error / rung.heldback_noise;
-    (r <= FLOOR_BAND && rh <= FLOOR_BAND).then_some(StopReason::NoiseFloor {
+    let band = rung.band.ratio;
+    (r <= band && rh <= band).then_some(StopReason::NoiseFloor {
         error: rung.error,
         noise_floor: rung.noise,
         heldback_error: rung.heldback_error,
         heldback_noise_floor: rung.heldback_noise,
-        band: FLOOR_BAND,
+        band,
     })
 }

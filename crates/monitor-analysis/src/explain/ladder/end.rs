@@ -12,7 +12,6 @@
 use super::base::{base_changes, prior_weight};
 use super::climb::Ladder;
 use super::report::{FinalFit, NotSeparable};
-use super::rules::FLOOR_BAND;
 use super::rung::{nested_from, setup_list};
 use crate::analysis::{align, Analysis, AnalysisError, FittedEffect, MAX_ITER};
 use crate::effects::EffectModel;
@@ -117,7 +116,7 @@ impl Ladder<'_> {
                 let m = crate::leftover::Measured {
                     error,
                     noise_floor: noise,
-                    band: FLOOR_BAND,
+                    band: self.series.band.ratio,
                 };
                 crate::leftover::locate(&file.data, &fin.constants, &pred, m)
             })
@@ -133,8 +132,8 @@ impl Ladder<'_> {
 
     /// Whether the change of `key` the fit `mf` reads (whole-log error `error`, floor
     /// `noise`) is the log's own evidence: the same model refitted with `key` held at the
-    /// file's value. Where that model still explains the log within the noise-floor band
-    /// ([`FLOOR_BAND`]), the change only trades with the effects' values (or the
+    /// file's value. Where that model still explains the log within the log's noise-floor
+    /// band ([`super::rules::FLOOR_BAND`] on a short log, [`super::rules::FloorBand`]), the change only trades with the effects' values (or the
     /// other base parameters): it is not separable on this log ([`NotSeparable`]), not a
     /// finding. (A model above the band keeps its changes: the error the effects leave is
     /// not the change's to carry, and a small true change removes little of it.)
@@ -165,7 +164,7 @@ impl Ladder<'_> {
         } else {
             0.0
         };
-        if e_pin / noise > FLOOR_BAND {
+        if e_pin / noise > sr.band.ratio {
             return Ok(None);
         }
         let traded_with = rung

@@ -20,7 +20,8 @@
 //!    the whole-log error is kept, the others refused with why ([`Refusal`]).
 //! 4. **Both ways** (`stepwise.rs`): after a step, an earlier effect the model no longer
 //!    needs is dropped (the step explains what it stood in for).
-//! 5. **The stop** (`climb.rs`): within the noise-floor band ([`FLOOR_BAND`]) on the
+//! 5. **The stop** (`climb.rs`): within the log's noise-floor band ([`FLOOR_BAND`], narrower
+//!    on a log longer than [`BAND_PERIODS`] supply periods: [`FloorBand`]) on the
 //!    whole log and the held-back part, or when no plausible candidate passes, or when the
 //!    library is exhausted ([`StopReason`]).
 //! 6. **The end** (`end.rs`): the chosen model refitted on the whole log with the base
@@ -54,9 +55,9 @@ pub use report::{
     LadderStep, NotSeparable, RangedValue, SplitInfo, Stratum, TestRule,
 };
 pub use rules::{
-    AS_ONE_WITHIN, BASE_CHANGE_MIN, EVENT_WINDOW_MAX_S, FINALISTS, FLOOR_BAND, LADDER_FIT_SAMPLES,
-    LADDER_MAX_FIT_SAMPLES, PAIRS_ABOVE, PAIR_FROM, SCREEN_ITER, STEP_MIN, WINDOW_MAX_S,
-    WINDOW_MIN_PERIODS,
+    FloorBand, AS_ONE_WITHIN, BAND_EXCESS_MIN, BAND_PERIODS, BASE_CHANGE_MIN, EVENT_WINDOW_MAX_S,
+    FINALISTS, FLOOR_BAND, LADDER_FIT_SAMPLES, LADDER_MAX_FIT_SAMPLES, PAIRS_ABOVE, PAIR_FROM,
+    SCREEN_ITER, STEP_MIN, WINDOW_MAX_S, WINDOW_MIN_PERIODS,
 };
 pub use rung::fit_thinning;
 pub use split::stratified_heldback;
@@ -88,6 +89,7 @@ impl Analysis {
         let configured = resolve(&opts.effects, &opts.laws);
         let mut ladder = Ladder::start(self, &library, &configured, opts, held, progress)?;
         report.start = ladder.start_figures();
+        report.test_rule.floor_band = ladder.series.band.ratio;
         let reason = ladder.climb()?;
         ladder.report(reason, &mut report)?;
         Ok(report)

@@ -32,6 +32,63 @@ pub const STEP_MIN: f64 = 0.1;
 /// and on the held-back part, has nothing left to explain (the same margin as
 /// [`NOISE_MARGIN`]: a model error beyond the noise of half the noise floor).
 pub const FLOOR_BAND: f64 = NOISE_MARGIN;
+/// Supply periods of the longest logs [`FLOOR_BAND`] was set on (10 s at 50 Hz: the
+/// ladder's benchmark and the analysis sweeps' logs). A longer log's band narrows
+/// ([`FloorBand::of_periods`]).
+pub const BAND_PERIODS: f64 = 500.0;
+/// The narrowest band, as the model error beyond the noise it lets through, in units of
+/// the noise floor (0.25: 1.03x the floor). The floor is measured, not known: on long
+/// clean logs whose model is complete (the 40 s controls of motulator's 2.2 kW machine,
+/// the 3 hp and 0.37 kW machines) the error ends 0.98-1.02x it, so a band inside that
+/// would send a control's ladder on to fit the floor's own error.
+pub const BAND_EXCESS_MIN: f64 = 0.25;
+
+/// The noise-floor band of one log: the ratio to its floor within which the ladder stops,
+/// and the matching model error beyond the noise below which nothing is left to explain
+/// (the step's test reads a share of an excess below it as 0).
+///
+/// The excess `x` is half the noise floor on a log of up to [`BAND_PERIODS`] supply
+/// periods ([`FLOOR_BAND`], 1.12x), and shrinks with the square root of the log's length
+/// beyond, `x = 0.5 sqrt(BAND_PERIODS / periods)`, to [`BAND_EXCESS_MIN`] at four times
+/// as long; the ratio is `FLOOR_BAND sqrt(1 + x²) / sqrt(1.25)` (1.12x at `x = 0.5`,
+/// 1.03x at 0.25). A model error is correlated over an event, not over a sample: what a
+/// log adds to the evidence is its supply periods, each a new look at every stretch of
+/// its service, and an excess estimated over four times as many periods is known to half
+/// the spread. A 40 s log at 60 Hz of a 3 hp machine warming by 50 K ended at 1.04x with the
+/// dynamics alone and never tried the drift, which its 2 400 periods show (issue 87).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FloorBand {
+    /// Stop within this factor of the noise floor (whole log and held-back part).
+    pub ratio: f64,
+    /// The model error beyond the noise (`sqrt(E² - N²)`) in units of the floor `N`
+    /// below which there is nothing left to explain.
+    pub excess: f64,
+}
+
+impl FloorBand {
+    /// The band of a log of `periods` supply periods (the working series' supply angle
+    /// over 2 pi; not finite or not positive: the short log's band).
+    pub fn of_periods(periods: f64) -> Self {
+        const X_SHORT: f64 = 0.5;
+        let x = if periods.is_finite() && periods > BAND_PERIODS {
+            (X_SHORT * (BAND_PERIODS / periods).sqrt()).max(BAND_EXCESS_MIN)
+        } else {
+            X_SHORT
+        };
+        FloorBand {
+            ratio: FLOOR_BAND * ((1.0 + x * x) / (1.0 + X_SHORT * X_SHORT)).sqrt(),
+            excess: x,
+        }
+    }
+
+    /// The share of the model error beyond the noise floor `noise` that a change from
+    /// `e_base` to `e_with` removes ([`crate::explain::explained_fraction`] with this band's
+    /// excess as the least there is to explain).
+    pub fn explained(&self, e_base: f64, e_with: f64, noise: f64) -> f64 {
+        crate::explain::explained_fraction_beyond(e_base, e_with, noise, self.excess)
+    }
+}
+
 /// Longest held-back or fitted window of a stratum [s] before it is cut further: a steady
 /// stretch is interleaved at least this finely.
 pub const WINDOW_MAX_S: f64 = 0.5;
@@ -47,10 +104,12 @@ pub const EVENT_WINDOW_MAX_S: f64 = 0.08;
 /// effects are refused on a series that does not, [`crate::transients::not_proposed`]).
 pub const LADDER_FIT_SAMPLES: usize = 20_000;
 /// Largest fit copy of a long log whose dynamics need more samples than
-/// [`LADDER_FIT_SAMPLES`] ([`super::rung::fit_thinning`]): three times as many (a 60 s log at 2 kHz at
-/// 1 kHz), beyond which the copy is thinned to this size and the dynamics effects are
-/// refused as unresolved.
-pub const LADDER_MAX_FIT_SAMPLES: usize = 60_000;
+/// [`LADDER_FIT_SAMPLES`] ([`super::rung::fit_thinning`]): six times as many, a minute at
+/// 2 kHz at the log's own rate, beyond which the copy is thinned to this size and the
+/// dynamics effects are refused as unresolved. At 60 000 a 40 s log at 2 kHz of a 0.37 kW
+/// machine (a 2.1 ms stator transient) was fitted at 1 kHz, its dynamics refused, and its
+/// ladder stopped at 11x the floor with "nothing plausible helps", warming or not.
+pub const LADDER_MAX_FIT_SAMPLES: usize = 120_000;
 /// Iterations of a round's screening fit of every candidate (`round/`): enough to rank
 /// them; the [`FINALISTS`] best are then fitted in full.
 pub const SCREEN_ITER: usize = 6;

@@ -3,7 +3,7 @@
 //! fitted step is not physical.
 
 use super::refusal::WhyNotPhysical;
-use super::rules::{LADDER_FIT_SAMPLES, LADDER_MAX_FIT_SAMPLES};
+use super::rules::{FloorBand, LADDER_FIT_SAMPLES, LADDER_MAX_FIT_SAMPLES};
 use super::split::{mask_on, weights_for};
 use crate::analysis::{align, coarsen, Analysis, AnalysisError};
 use crate::base_range::base_newly_out_of_range;
@@ -36,6 +36,8 @@ pub(super) struct LadderSeries {
     /// Whether the base parameters are refitted at all (the base rung and the final
     /// refit; `--no-fit-base` keeps the file's).
     pub(super) fit_base: bool,
+    /// The log's noise-floor band (its length in supply periods, [`FloorBand::of_periods`]).
+    pub(super) band: FloorBand,
 }
 
 /// The model of a ladder step: its effects, their set-ups on the fit series, and the fit.
@@ -56,6 +58,16 @@ pub(super) struct Rung<'a> {
     pub(super) heldback_noise_fit_series: f64,
     /// The error over time on the working series ([`metrics::error_over_time`]).
     pub(super) over_time: Vec<(f64, f64)>,
+    /// The log's noise-floor band (the series').
+    pub(super) band: FloorBand,
+}
+
+impl Rung<'_> {
+    /// The share of the error beyond the noise floor `noise` a change from `e_base` to
+    /// `e_with` removes, within this log's band ([`FloorBand::explained`]).
+    pub(super) fn explained(&self, e_base: f64, e_with: f64, noise: f64) -> f64 {
+        self.band.explained(e_base, e_with, noise)
+    }
 }
 
 /// A candidate fitted in one round.
@@ -138,6 +150,7 @@ impl LadderSeries {
             heldback_fit_series: hb_fd,
             heldback_noise_fit_series: hn_fd,
             over_time,
+            band: self.band,
         })
     }
 }
@@ -292,12 +305,25 @@ impl LadderSeries {
             span: transients::Span::of(&fd, &an.constants),
             file: an.params,
             fit_base,
+            band: FloorBand::of_periods(supply_periods(&an.data)),
             fd,
             m,
             held,
             held_fd,
         }
     }
+}
+
+/// The supply periods of the working series `d`: its supply angle over 2 pi, from the
+/// measured supply frequency of each sample (non-finite samples count nothing).
+fn supply_periods(d: &Prepared) -> f64 {
+    let angle: f64 = d
+        .omega_s
+        .iter()
+        .filter(|w| w.is_finite())
+        .map(|w| w.abs() * d.dt_s)
+        .sum();
+    angle / std::f64::consts::TAU
 }
 
 /// The fastest time constant of the library's dynamics effects on machine `n` [s] (the

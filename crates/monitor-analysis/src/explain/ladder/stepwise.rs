@@ -11,7 +11,7 @@ use super::rules::STEP_MIN;
 use super::rung::{nested_from, Rung};
 use crate::analysis::{Analysis, AnalysisError};
 use crate::effects::EffectModel;
-use crate::explain::{explained_fraction, PARAM_PENALTY};
+use crate::explain::PARAM_PENALTY;
 use crate::fit::{self, BaseSpec, FitResult};
 use crate::metrics;
 use monitor_laws::EffectId;
@@ -92,8 +92,8 @@ impl<'a> Ladder<'a> {
             step.heldback_noise_floor = rung.heldback_noise;
             step.ratio_to_floor = rung.error / rung.noise;
             step.heldback_ratio_to_floor = rung.heldback_error / rung.heldback_noise;
-            step.explained = explained_fraction(before.error, rung.error, rung.noise);
-            step.heldback_explained = explained_fraction(
+            step.explained = rung.explained(before.error, rung.error, rung.noise);
+            step.heldback_explained = rung.explained(
                 before.heldback_error,
                 rung.heldback_error,
                 rung.heldback_noise,
@@ -166,7 +166,7 @@ impl<'a> Ladder<'a> {
             i,
             models,
             fit: f,
-            significance: explained_fraction(hb, with, next.heldback_noise_fit_series),
+            significance: next.explained(hb, with, next.heldback_noise_fit_series),
         }))
     }
 }

@@ -197,13 +197,16 @@ fn what_the_user_configured_and_the_machine_order_stay() {
 /// The fit copy of a long log keeps the machine's fastest dynamics resolved: a 22 s log at
 /// 2 kHz (44 000 samples) with a 3.6 ms stator transient is thinned by 2 (1 kHz, 3.6
 /// samples per time constant), where the budget alone (20 000 samples) asked 3 (667 Hz,
-/// 2.4 samples); a 10 s log at 2 kHz is not thinned; a 60 min log is thinned to the copy's
-/// largest size.
+/// 2.4 samples); a 10 s log at 2 kHz is not thinned, nor a 40 s one whose transient needs
+/// the log's rate; a 60 min log is thinned to the copy's largest size.
 #[test]
 fn a_long_log_is_thinned_no_further_than_its_dynamics_allow() {
     assert_eq!(fit_thinning(44_000, 5e-4, 3.6e-3), 2);
     assert_eq!(fit_thinning(44_000, 5e-4, 2.9e-3), 1);
     assert_eq!(fit_thinning(20_000, 5e-4, 3.6e-3), 1);
+    // A 40 s log at 2 kHz of a small machine (a 2.1 ms stator transient) keeps the log's
+    // own rate: at 1 kHz its dynamics were refused (issue 87).
+    assert_eq!(fit_thinning(80_000, 5e-4, 2.1e-3), 1);
     // A slow machine's log may be thinned as the budget asks.
     assert_eq!(fit_thinning(80_000, 5e-4, 20e-3), 4);
     // Beyond the copy's largest size the budget wins (the dynamics are then refused).
@@ -214,4 +217,28 @@ fn a_long_log_is_thinned_no_further_than_its_dynamics_allow() {
         let m = fit_thinning(len, 5e-4, tau);
         assert!(tau / (m as f64 * 5e-4) >= 3.0 || len / m > LADDER_MAX_FIT_SAMPLES);
     }
+}
+
+/// The noise-floor band narrows with the log's supply periods (issue 87): 1.12x up to 500
+/// periods (10 s at 50 Hz, what the band was set on), half the excess at four times as many
+/// (1.03x: 40 s at 50 Hz), never narrower; and the step's test reads an excess within the
+/// band as nothing to explain, one beyond it as something.
+#[test]
+fn the_floor_band_narrows_with_the_logs_supply_periods() {
+    let short = FloorBand::of_periods(200.0);
+    assert_eq!(short.ratio, FLOOR_BAND);
+    assert_eq!(short.excess, 0.5);
+    assert_eq!(FloorBand::of_periods(f64::NAN), short);
+    assert_eq!(FloorBand::of_periods(BAND_PERIODS), short);
+    let long = FloorBand::of_periods(4.0 * BAND_PERIODS);
+    assert!((long.excess - 0.25).abs() < 1e-12);
+    assert!((long.ratio - 1.0326).abs() < 1e-3, "{}", long.ratio);
+    let twice = FloorBand::of_periods(2.0 * BAND_PERIODS);
+    assert!(twice.ratio < short.ratio && twice.ratio > long.ratio);
+    assert_eq!(FloorBand::of_periods(100.0 * BAND_PERIODS), long);
+    assert!(BAND_EXCESS_MIN == long.excess);
+    // A model error 1.04x its floor (an excess of 0.29 of the floor): nothing to explain on a
+    // short log, all of it explained by a model at the floor on a long one.
+    assert_eq!(short.explained(1.04, 1.0, 1.0), 0.0);
+    assert!((long.explained(1.04, 1.0, 1.0) - 1.0).abs() < 1e-12);
 }

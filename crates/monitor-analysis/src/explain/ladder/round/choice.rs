@@ -10,7 +10,6 @@ use super::super::rules::STEP_MIN;
 use super::super::rung::{Fitted, Rung};
 use crate::analysis::{Analysis, AnalysisError};
 use crate::effects::{self, EffectModel};
-use crate::explain::explained_fraction;
 use crate::simplified_model::MachineConstants;
 use monitor_laws::EffectId;
 use std::collections::BTreeMap;
@@ -279,8 +278,8 @@ fn step_between(rung: &Rung<'_>, next: &Rung<'_>, sig: f64) -> LadderStep {
         ratio_to_floor: next.error / next.noise,
         heldback_ratio_to_floor: next.heldback_error / next.heldback_noise,
         significance: sig,
-        explained: explained_fraction(rung.error, next.error, next.noise),
-        heldback_explained: explained_fraction(
+        explained: rung.explained(rung.error, next.error, next.noise),
+        heldback_explained: rung.explained(
             rung.heldback_error,
             next.heldback_error,
             next.heldback_noise,
@@ -293,7 +292,7 @@ fn step_between(rung: &Rung<'_>, next: &Rung<'_>, sig: f64) -> LadderStep {
 /// held-back error beyond the noise floor it removes, its held-back error first raised by
 /// [`crate::explain::PARAM_PENALTY`] per parameter.
 fn significance(rung: &Rung<'_>, c: &Fitted<'_>) -> f64 {
-    explained_fraction(
+    rung.explained(
         rung.heldback_fit_series,
         c.score(),
         rung.heldback_noise_fit_series,

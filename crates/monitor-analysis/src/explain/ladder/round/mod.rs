@@ -20,7 +20,7 @@ use super::rules::{PAIRS_ABOVE, PAIR_FROM};
 use super::rung::{Fitted, Rung};
 use crate::analysis::{Analysis, AnalysisError};
 use crate::effects::EffectModel;
-use crate::explain::{explained_fraction, SkipReason, Skipped};
+use crate::explain::{SkipReason, Skipped};
 use crate::fit::BaseSpec;
 use crate::simplified_model::MachineConstants;
 use crate::transients;
@@ -303,8 +303,8 @@ fn pairs_of<'a>(fitted: &[Fitted<'a>], before: usize) -> Vec<Vec<&'a dyn EffectM
 /// `rung` to `next`.
 fn restated<'a>((next, mut step): Kept<'a>, rung: &Rung<'_>, judged: bool) -> Kept<'a> {
     if judged {
-        step.explained = explained_fraction(rung.error, next.error, next.noise);
-        step.heldback_explained = explained_fraction(
+        step.explained = rung.explained(rung.error, next.error, next.noise);
+        step.heldback_explained = rung.explained(
             rung.heldback_error,
             next.heldback_error,
             next.heldback_noise,
