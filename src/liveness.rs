@@ -273,4 +273,13 @@ mod tests {
         assert!(w.poll(u32::MAX - 10, u32::MAX).pet_watchdog);
         assert!(w.poll(600, 40).pet_watchdog, "counter and clock wrapped");
     }
+
+    /// The start-up grace is [`STARTUP_GRACE_MS`] from boot and no more: with no sample
+    /// yet, the watchdog is petted at 199 ms and not at 200 ms.
+    #[test]
+    fn the_start_up_grace_ends_at_200_ms() {
+        let mut w = SampleWatch::new(10_000, 5_000);
+        assert!(w.poll(0, 5_199).pet_watchdog);
+        assert!(!w.poll(0, 5_200).pet_watchdog);
+    }
 }

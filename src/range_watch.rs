@@ -90,3 +90,52 @@ impl RangeWatch {
         s.commissioned && s.evaluating && !s.stage.is_active() && self.commissioned.moved(s.point)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn moment(load_a: f32, stage: RunStage, quasi_steady: bool) -> RangeMoment {
+        RangeMoment {
+            point: OperatingPoint {
+                load_a,
+                voltage_v: 325.0,
+            },
+            stage,
+            run: 1,
+            quasi_steady,
+            commissioned: false,
+            evaluating: true,
+        }
+    }
+
+    /// The commissioned range is what the run learned at steady operating points: a status
+    /// with the quasi-steady gate closed (a load step's transient) or one past the learning
+    /// (the run's end, its storage) widens nothing.
+    #[test]
+    fn only_quasi_steady_points_of_a_learning_run_widen_the_range() {
+        let mut w = RangeWatch::new();
+        w.observe(&moment(10.0, RunStage::Learning, true));
+        w.observe(&moment(12.0, RunStage::Learning, true));
+        w.observe(&moment(30.0, RunStage::Learning, false));
+        w.observe(&moment(50.0, RunStage::Done, true));
+        w.commit(1);
+        assert_eq!(w.commissioned().load_a, Some([10.0, 12.0]));
+        assert_eq!(w.commissioned().voltage_v, Some([325.0, 325.0]));
+    }
+
+    /// A run that ends stored without a steady point learned (its statuses all with the
+    /// gate closed) leaves no range to judge against, not the range an earlier run learned.
+    #[test]
+    fn a_run_that_learned_no_point_commits_an_empty_range() {
+        let mut w = RangeWatch::new();
+        w.observe(&moment(10.0, RunStage::Learning, true));
+        w.commit(1);
+        assert!(w.commissioned().is_learned());
+        let mut second = moment(20.0, RunStage::Learning, false);
+        second.run = 2;
+        w.observe(&second);
+        w.commit(2);
+        assert_eq!(*w.commissioned(), OperatingRange::EMPTY);
+    }
+}

@@ -257,4 +257,38 @@ mod tests {
         let s = b.build(&raw);
         assert!(s.clipped && !s.i_saturated && !s.v_saturated);
     }
+
+    /// A voltage conversion clipped (the per-conversion check's flag, the filtered codes
+    /// inside the range) marks the sample clipped as a current one does; and both front
+    /// ends clipped at once (a start's inrush on the current channels while a transient
+    /// clips the voltage ones) too.
+    #[test]
+    fn a_voltage_clip_and_a_clip_on_both_front_ends_are_clipped() {
+        let mut b = AdcSampler::new(FrontEnd::DEFAULT, 10_000).unwrap();
+        let mut raw = b.quantize(Abc::default(), Abc::default(), 0);
+        raw.clipped.voltage = true;
+        assert_eq!(
+            raw.clips(),
+            Clipped {
+                voltage: true,
+                current: false
+            }
+        );
+        assert!(b.build(&raw).clipped);
+        raw.clipped.current = true;
+        assert!(raw.clips().any());
+        assert!(b.build(&raw).clipped);
+    }
+
+    /// A dropped sample keeps its place in time: sample `n`'s timestamp is `n` periods
+    /// (100 us at 10 kHz) from the start, whether or not the ones before it were built.
+    #[test]
+    fn a_dropped_sample_keeps_its_place_in_time() {
+        let mut b = AdcSampler::new(FrontEnd::DEFAULT, 10_000).unwrap();
+        let raw = b.quantize(Abc::default(), Abc::default(), 0);
+        assert_eq!(b.build(&raw).timestamp_ticks, 0);
+        b.skip();
+        assert_eq!(b.build(&raw).timestamp_ticks, 200);
+        assert_eq!(b.build(&raw).timestamp_ticks, 300);
+    }
 }

@@ -352,6 +352,25 @@ fn a_stuck_adc_times_the_stop_out_and_a_working_one_stops_within_a_conversion() 
     assert!(!acq.regs.sample());
 }
 
+/// The recovery after one that timed out at `StopAdc`: ADC1 stopped then (`ADSTART = 0`),
+/// ADC2's conversion has ended since. RM0440 allows `ADSTP` only with `ADSTART = 1` and
+/// `ADDIS = 0`: the sequence sets it on neither stopped ADC (the model counts an `ADSTP`
+/// on a stopped ADC as a violation), and the acquisition resumes.
+#[test]
+fn a_recovery_after_a_timed_out_one_sets_no_adstp_on_a_stopped_adc() {
+    let mut acq = AdcDmaModel::running();
+    acq.regs.adc[1].stuck = true;
+    assert_eq!(
+        recovery::recover(&mut acq),
+        Err(StepTimeout(RecoveryStep::StopAdc))
+    );
+    assert!(acq.regs.violations.is_empty(), "{:?}", acq.regs.violations);
+    acq.regs.adc[1].stuck = false;
+    assert_eq!(recovery::recover(&mut acq), Ok(Faults::default()));
+    assert!(acq.regs.violations.is_empty(), "{:?}", acq.regs.violations);
+    assert!(acq.regs.sample() && acq.regs.sample());
+}
+
 /// The done-when of the overrun recovery: with the model's `EOC` behaviour, a forced
 /// overrun resumes within 2 ms (the sample task's timeout: 20 periods at 10 kHz) with no
 /// second overrun, every register access within its precondition; the same sequence
