@@ -82,6 +82,17 @@ fn named(effect: &str, truth: Option<(&str, f64)>) {
         .iter()
         .find(|s| added(s).iter().any(|e| e == effect))
         .unwrap_or_else(|| panic!("{effect} not named: the ladder added {effects:?}"));
+    // The found line states the values of the step that named the effect (issue 87,
+    // item 4: one story), not the final refit's, which may trade with the base.
+    let found = v["summary"].as_str().unwrap();
+    let said = step["summary"].as_str().unwrap();
+    if found.contains(&format!("{effect}: ")) {
+        assert!(
+            said.split("; ")
+                .any(|d| found.contains(&format!("{effect}: {d}"))),
+            "{effect}: the found line does not state the step's values\n  step: {said}\n  found: {found}"
+        );
+    }
     let last = steps.last().unwrap();
     let ratio = last["ratio_to_floor"].as_f64().unwrap();
     let start = v["start"]["error"].as_f64().unwrap();

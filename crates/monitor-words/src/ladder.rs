@@ -11,6 +11,7 @@ use monitor_analysis::explain::ladder::{
     StopReason, TestRule, Tried, WhatIsLeft, WhyNotPhysical, BAND_PERIODS, FLOOR_BAND,
 };
 use monitor_analysis::fit::machine::BaseKey;
+use monitor_analysis::EffectId;
 use serde_json::Value;
 
 /// `explain --ladder --json`'s document: the report's typed values, with the sentences a
@@ -283,7 +284,8 @@ pub fn summary(r: &LadderReport) -> String {
 }
 
 /// What the chosen model refitted on the whole log (`f`) holds that the start did not: the
-/// base changes, the machine's own dynamics, each other effect with its values.
+/// base changes, the machine's own dynamics, each other effect with the values of the step
+/// that added it ([`as_stepped`]; the whole log's refit's where no step describes it).
 fn found(r: &LadderReport, f: &FinalFit) -> Vec<String> {
     let mut found = Vec::new();
     if f.base.iter().any(|c| c.changed) {
@@ -309,11 +311,28 @@ fn found(r: &LadderReport, f: &FinalFit) -> Vec<String> {
         .filter(|e| !e.effect.is_dynamics() && !r.start.effects.contains(&e.effect))
         .filter(|e| !as_one(e.effect))
     {
-        found.push(format!("{}: {}", e.effect, e.summary));
+        found.push(format!(
+            "{}: {}",
+            e.effect,
+            as_stepped(r, e.effect).unwrap_or(&e.summary)
+        ));
         found.extend(f.alike.iter().filter(|a| a.effect == e.effect).map(alike));
     }
     found.extend(f.as_one.iter().map(one_load));
     found
+}
+
+/// Effect `id`'s values as the last step that added it describes them (`None` where no
+/// step describes it one by one). The found line states these: the step's values are the
+/// ones the held-back test judged, and its list reads the same; the final refit frees the
+/// base parameters beside every value, where an effect can trade its size with them (a
+/// load torque of -17.75 N m beside its step's +2.36 N m), and stays in the JSON's
+/// `final_fit.fitted`.
+fn as_stepped(r: &LadderReport, id: EffectId) -> Option<&str> {
+    r.ladder.iter().rev().find_map(|s| {
+        let i = s.added.iter().position(|a| *a == id)?;
+        (s.described.len() == s.added.len()).then(|| s.described[i].as_str())
+    })
 }
 
 /// `load_torque and coulomb_friction fit this log alike (1.01x and 1.02x its noise floor):
