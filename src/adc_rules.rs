@@ -148,6 +148,34 @@ mod tests {
         assert_eq!(cr_setting(ADVREGEN | ADEN, ADSTART), ADVREGEN | ADSTART);
     }
 
+    /// `ADC_CR`'s bits where RM0440 puts them: `ADEN` 0, `ADDIS` 1, `ADSTART` 2, `JADSTART`
+    /// 3, `ADSTP` 4, `JADSTP` 5, `ADVREGEN` 28, `ADCAL` 31; the set-only ones are ST's
+    /// `ADC_CR_BITS_PROPERTY_RS`, 0x8000_003F.
+    #[test]
+    fn the_control_registers_bits_are_rm0440s() {
+        assert_eq!(
+            [ADEN, ADDIS, ADSTART, JADSTART, ADSTP, JADSTP],
+            [0x01, 0x02, 0x04, 0x08, 0x10, 0x20]
+        );
+        assert_eq!((ADVREGEN, ADCAL), (0x1000_0000, 0x8000_0000));
+        assert_eq!(CR_SET_ONLY, 0x8000_003F);
+        // Every set-only bit read as 1 (no real state has them all; each is to be dropped),
+        // the regulator on and ADCALDIF (bit 30) set: JADSTP is written with bits 28 and 30
+        // as read, and alone of the set-only bits.
+        assert_eq!(cr_setting(0xD000_003F, 0x20), 0x5000_0020);
+    }
+
+    /// The errata's condition is a conversion more than 1 ms after the previous one: 1 ms
+    /// exactly drops nothing, 1 ms and 1 us does.
+    #[test]
+    fn an_idle_of_exactly_one_millisecond_drops_nothing() {
+        let mut d = IdleDiscard::default();
+        d.on_start(1_000);
+        assert!(!d.drop_next());
+        d.on_start(1_001);
+        assert!(d.drop_next());
+    }
+
     #[test]
     fn only_a_long_idle_drops_a_sample_and_only_one() {
         let mut d = IdleDiscard::default();

@@ -267,6 +267,58 @@ mod tests {
         assert!(!changes[0].too_small && !w.too_small());
     }
 
+    /// "More than 1 %": steady windows with 1 % of their samples clipped, 200 of 20 000,
+    /// set nothing however long; 1.01 %, 202, sets the state at the end of the third.
+    #[test]
+    fn exactly_one_percent_clipped_sets_nothing_and_just_over_sets_it() {
+        let mut w = ClipWatch::new(FS);
+        let mut at = ClipMoment::default();
+        assert!(run(&mut w, &mut at, 30.0, 100, |_| 150.0).is_empty());
+        let changes = run(&mut w, &mut at, 8.0, 101, |_| 150.0);
+        assert_eq!(changes.len(), 1, "{changes:?}");
+        assert!(changes[0].too_small && w.too_small());
+    }
+
+    /// A motor slowing from 150 to 100 rad/s over 8 s, 12.5 rad/s a window (more than 8 %
+    /// of its fastest status), is not running steadily, either way round: its clips set
+    /// nothing.
+    #[test]
+    fn a_motor_slowing_down_is_not_steady_running() {
+        for sign in [1.0, -1.0] {
+            let mut w = ClipWatch::new(FS);
+            let mut at = ClipMoment::default();
+            let slowing = |t: f32| sign * (150.0 - 6.25 * t);
+            assert!(run(&mut w, &mut at, 8.0, 2_000, slowing).is_empty());
+            assert!(!w.too_small());
+        }
+    }
+
+    /// "At most 0.1 %" counts towards clearing: steady windows of 20 999 samples with 21
+    /// clipped (0.100 05 %) leave the range state set however many; windows of 20 000 with
+    /// 20 clipped (0.1 %) clear it at the end of the third.
+    #[test]
+    fn at_most_a_tenth_of_a_percent_clipped_clears_the_range_state() {
+        let mut w = ClipWatch::new(FS);
+        let mut at = ClipMoment::default();
+        assert_eq!(run(&mut w, &mut at, 8.0, 2_000, |_| 150.0).len(), 1);
+        assert!(w.too_small());
+        // One status a window: `samples` more, `clipped` of them clipped, still at 150 rad/s.
+        let mut window = |samples: u32, clipped: u32| {
+            at.samples += samples;
+            at.clipped += clipped;
+            at.clipped_current += clipped;
+            w.observe(&at)
+        };
+        for _ in 0..6 {
+            assert_eq!(window(20_999, 21), None);
+        }
+        assert_eq!(window(20_000, 20), None);
+        assert_eq!(window(20_000, 20), None);
+        let cleared = window(20_000, 20).expect("cleared at the third window");
+        assert!(!cleared.too_small && cleared.permille == 1);
+        assert!(!w.too_small());
+    }
+
     #[test]
     fn isolated_clips_a_stall_and_an_interrupted_clip_set_nothing() {
         // A clip a second (17 samples with the hold: 0.085 %), steady: nothing.

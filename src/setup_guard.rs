@@ -130,6 +130,20 @@ mod tests {
         assert_eq!(systick_reload(170_000_000, 0), None);
     }
 
+    /// PM0214, "SysTick reload value register": `RELOAD` is 24 bits, 0x00_0001 to
+    /// 0xFF_FFFF; a reload of 0 never fires (the exception comes as the counter goes from 1
+    /// to 0).
+    #[test]
+    fn the_reload_stays_within_systicks_24_bits_and_above_zero() {
+        // HCLK / 8 = 2^24 Hz for 1 s: 2^24 ticks, the reload 0xFF_FFFF, the largest.
+        assert_eq!(systick_reload(134_217_728, 1_000), Some(0x00FF_FFFF));
+        // 1 Hz more at SysTick (8 Hz of HCLK): a reload of 2^24, beyond 24 bits.
+        assert_eq!(systick_reload(134_217_736, 1_000), None);
+        // HCLK / 8 = 1 kHz: 1 ms is one tick, a reload of 0; 2 ms a reload of 1.
+        assert_eq!(systick_reload(8_000, 1), None);
+        assert_eq!(systick_reload(8_000, 2), Some(1));
+    }
+
     #[test]
     fn a_step_that_overruns_the_deadline_is_reported_at_the_next_boot() {
         assert_eq!(on_deadline(0), None, "disarmed: nothing happens");

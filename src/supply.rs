@@ -506,6 +506,42 @@ mod tests {
         assert_eq!(measure_now(&mut adc), ReferenceCheck::Unreadable);
     }
 
+    /// The status line's VDDA is 0 before the start-up check and when unreadable, the
+    /// measured one in band and out of band; a commissioning stores it only in band.
+    #[test]
+    fn the_watch_gives_the_measured_vdda() {
+        let mut w = ReferenceWatch::new(REFERENCE_PERIOD_MS);
+        assert_eq!((w.vdda_v(), w.in_band_v(), w.latest()), (0.0, None, None));
+        w.observe(ReferenceCheck::InBand(3.3), 0);
+        assert_eq!((w.vdda_v(), w.in_band_v()), (3.3, Some(3.3)));
+        w.observe(ReferenceCheck::OutOfBand(3.0), 1_000);
+        assert_eq!((w.vdda_v(), w.in_band_v()), (3.0, None));
+        w.observe(ReferenceCheck::Unreadable, 2_000);
+        assert_eq!((w.vdda_v(), w.in_band_v()), (0.0, None));
+    }
+
+    /// A conversion every 1 s from the last result, started by the first period at or after
+    /// its time (a late one too); one not done within 200 ms is unreadable.
+    #[test]
+    fn the_watch_converts_each_second_and_waits_200_ms_for_a_result() {
+        let mut adc = Fake {
+            vdda: 3.3,
+            cal: 1655,
+            pending: false,
+            converts: false,
+            since_enable_us: Some(100.0),
+        };
+        let mut w = ReferenceWatch::new(REFERENCE_PERIOD_MS);
+        w.observe(ReferenceCheck::InBand(3.3), 0);
+        assert_eq!(w.poll(999, &mut adc), None);
+        assert!(!adc.pending, "due at 1 000 ms, not before");
+        assert_eq!(w.poll(1_013, &mut adc), None);
+        assert!(adc.pending, "started 13 ms late");
+        assert_eq!(w.poll(1_212, &mut adc), None, "199 ms: still waiting");
+        let unreadable = Some(ReferenceChange::Flagged(ReferenceCheck::Unreadable));
+        assert_eq!(w.poll(1_213, &mut adc), unreadable);
+    }
+
     /// RM0440's `BOR_LEV` thresholds (falling, about): 1.7, 2.0, 2.2, 2.5, 2.8 V, each level
     /// higher than the one before; the goal's 2.8 V is below the NUCLEO's 3.3 V supply.
     #[test]

@@ -24,6 +24,10 @@ struct Pair {
     stuck: bool,
     /// The prescaler another writer left (read back instead of the HAL's).
     overwritten: Option<u32>,
+    /// An ADC1 its `create` leaves disabled.
+    left_disabled: bool,
+    /// An ADC1 found converting (`ADSTART = 1`) after its `create`.
+    converting: bool,
     violations: Vec<String>,
 }
 
@@ -37,10 +41,15 @@ impl AdcPairSetup for Pair {
             ));
         }
         self.presc = PRESC_DIV4;
-        self.enabled[i] = true;
+        self.enabled[i] = !(i == 0 && self.left_disabled);
     }
     fn cr(&mut self, i: usize) -> u32 {
-        ADVREGEN | if self.enabled[i] { ADEN } else { 0 }
+        let adstart = if i == 0 && self.converting {
+            ADSTART
+        } else {
+            0
+        };
+        ADVREGEN | adstart | if self.enabled[i] { ADEN } else { 0 }
     }
     fn write_cr(&mut self, i: usize, value: u32) {
         if (value & SET_ONLY).count_ones() > 1 {
@@ -52,7 +61,8 @@ impl AdcPairSetup for Pair {
                 .push(format!("ADC{}_CR: ADVREGEN cleared", i + 1));
         }
         if value & ADDIS != 0 {
-            if !self.enabled[i] || value & (ADSTART | JADSTART) != 0 {
+            let converting = i == 0 && self.converting;
+            if !self.enabled[i] || converting || value & (ADSTART | JADSTART) != 0 {
                 self.violations
                     .push(format!("ADDIS on ADC{} not allowed", i + 1));
             }
@@ -92,4 +102,28 @@ fn the_common_prescaler_is_written_with_both_adcs_disabled_and_read_back() {
         ..Pair::default()
     };
     assert_eq!(create_pair(&mut stuck), Err(PairError::NotDisabled));
+}
+
+/// RM0440: software sets `ADDIS` only with `ADEN = 1` and no conversion ongoing (`ADSTART =
+/// 0`, `JADSTART = 0`). An ADC1 already disabled is left so and the set-up goes on; an ADC1
+/// found converting gets no `ADDIS`, stays enabled, and the set-up reports it.
+#[test]
+fn addis_is_written_only_to_an_enabled_adc1_that_is_not_converting() {
+    let mut disabled = Pair {
+        left_disabled: true,
+        ..Pair::default()
+    };
+    assert_eq!(create_pair(&mut disabled), Ok(()));
+    assert!(disabled.violations.is_empty(), "{:?}", disabled.violations);
+
+    let mut converting = Pair {
+        converting: true,
+        ..Pair::default()
+    };
+    assert_eq!(create_pair(&mut converting), Err(PairError::NotDisabled));
+    assert!(
+        converting.violations.is_empty(),
+        "{:?}",
+        converting.violations
+    );
 }
