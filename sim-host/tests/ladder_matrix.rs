@@ -252,6 +252,8 @@ struct Outcome {
     seconds: f64,
     /// The command failed (its stderr).
     failed: Option<String>,
+    /// Effects the end names in the place of a base change (`final_fit.base[].in_place`).
+    in_place: BTreeSet<String>,
 }
 
 fn run_case(dir: &Path, n: usize, case: &Case) -> Outcome {
@@ -281,6 +283,7 @@ fn run_case(dir: &Path, n: usize, case: &Case) -> Outcome {
         steps: Vec::new(),
         seconds,
         failed: None,
+        in_place: BTreeSet::new(),
     };
     if !out.status.success() {
         o.failed = Some(String::from_utf8_lossy(&out.stderr).into_owned());
@@ -288,6 +291,11 @@ fn run_case(dir: &Path, n: usize, case: &Case) -> Outcome {
     }
     let j: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON document");
     let num = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+    for b in j["final_fit"]["base"].as_array().into_iter().flatten() {
+        if let Some(e) = b["in_place"]["effect"].as_str() {
+            o.in_place.insert(e.to_string());
+        }
+    }
     o.errors.push(num(&j["start"]["error"]));
     o.end_ratio = num(&j["start"]["ratio_to_floor"]);
     for step in j["ladder"].as_array().into_iter().flatten() {
@@ -464,7 +472,14 @@ fn the_ladder_names_hidden_effects_of_a_textbook_machine() {
     let missed: Vec<String> = pairs
         .iter()
         .filter(|(o, h)| !o.names(h))
-        .map(|(o, h)| format!("{h} missed in {}", o.details()))
+        .map(|(o, h)| {
+            let said = if o.in_place.contains(*h) {
+                " (named at the end in the place of a base change)"
+            } else {
+                ""
+            };
+            format!("{h} missed{said} in {}", o.details())
+        })
         .collect();
     let named_share = 1.0 - missed.len() as f64 / pairs.len().max(1) as f64;
     eprintln!(

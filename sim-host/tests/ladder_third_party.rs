@@ -18,7 +18,14 @@
 //! * (b) no effect named that is neither hidden nor allowed on its log;
 //! * (c) the whole-log error never rises along the ladder (base and effect rungs), every log;
 //! * (d) the end within 2x the noise floor or 5x below the start on at least 90 % of the logs;
-//! * (e) no change of `rs` beyond 3 % on the logs whose stator is at the file's temperature.
+//! * (e) no change of `rs` beyond 3 % on the logs whose stator is at the file's temperature;
+//! * (f) a fan the ladder does not name is not reported as a change of `B + Bl` that carries
+//!   it: the end names windage in that change's place (`final_fit.base[].in_place`) with
+//!   the log's `k` within 10 % (issue 87: `kw2p2_fan_saturation` read B + Bl 20 times the
+//!   file's as a finding);
+//! * (g) no change of `j` beyond 3 % on the logs whose file holds the machine's inertia
+//!   exactly (the 2.2 kW files: `tools/motulator-logs/README.md`, "The parameter file a user
+//!   has"); the fan's log read J -9 % beside the viscous friction that stood in for its fan.
 //!
 //! The ladder's JSON read here: `start` {error, ...}; `ladder`, the rungs in order, each
 //! with `error` and `ratio_to_floor`; an effect rung with `effect`, `added` and perhaps
@@ -66,7 +73,23 @@ struct Entry {
     stator_at_file_temperature: bool,
     /// The stator's resistance over the file's, less one, where it is warm.
     warm_stator: Option<f64>,
+    /// The hidden effects' true sizes (the fan's `windage_k_nms2`).
+    #[serde(default)]
+    sizes: Sizes,
 }
+
+/// The manifest's sizes of a log the bars read.
+#[derive(Deserialize, Clone, Default)]
+struct Sizes {
+    /// The fan's `k` of `k w |w|` [N m s^2/rad^2], where the log has one.
+    windage_k_nms2: Option<f64>,
+}
+
+/// Largest |j change| on the logs of the 2.2 kW files (`kw2p2*.toml`), whose inertia is
+/// exact (bar (g)).
+const J_STILL: f64 = 0.03;
+/// Relative tolerance on the fan's `k` named in the place of a change of B + Bl.
+const FAN_TOL: f64 = 0.10;
 
 /// The pseudo-effect of a warm stator: a base change of rs, not a library effect.
 const WARM: &str = "warm_stator";
@@ -104,6 +127,8 @@ struct Outcome {
     seconds: f64,
     /// The command failed (its stderr).
     failed: Option<String>,
+    /// The ladder's JSON document.
+    json: Value,
 }
 
 fn strings(v: &Value) -> Vec<String> {
@@ -152,6 +177,7 @@ fn run(e: &Entry) -> Outcome {
         stopped_because: String::new(),
         seconds: t.elapsed().as_secs_f64(),
         failed: None,
+        json: Value::Null,
     };
     if !out.status.success() {
         o.failed = Some(String::from_utf8_lossy(&out.stderr).into_owned());
@@ -189,6 +215,7 @@ fn run(e: &Entry) -> Outcome {
         Some(f) => strings(f).into_iter().collect(),
         None => o.added.difference(&o.dropped).cloned().collect(),
     };
+    o.json = j.clone();
     o.stop = j["stop"].as_str().unwrap_or_default().to_string();
     o.stopped_because = j["stopped_because"]
         .as_str()
@@ -238,6 +265,39 @@ impl Outcome {
             })
             .cloned()
             .collect()
+    }
+
+    /// (f): where the log's fan is not named, what is wrong with B + Bl's place (`None`: the
+    /// change is no finding and windage is named in its place with the log's `k`).
+    fn fan_as_viscous(&self) -> Option<String> {
+        let e = &self.entry;
+        if !e.hidden.iter().any(|h| h == "windage") || self.named.contains("windage") {
+            return None;
+        }
+        let name = &e.name;
+        if self.base.iter().any(|b| b.name == "b") {
+            return Some(format!(
+                "{name}: B + Bl reported as a change of the machine"
+            ));
+        }
+        let base = self.json["final_fit"]["base"].as_array();
+        let b = base.and_then(|l| l.iter().find(|b| b["base"] == "b"));
+        let k = b.and_then(|b| b["in_place"]["fitted"]["parameters"]["k_nms2"]["value"].as_f64());
+        let truth = e.sizes.windage_k_nms2;
+        match (k, truth) {
+            (Some(k), Some(t)) if (k / t - 1.0).abs() <= FAN_TOL => None,
+            _ => Some(format!(
+                "{name}: windage not named in B + Bl's place (k {k:?}, the log's {truth:?})"
+            )),
+        }
+    }
+
+    /// (g): the change of `j` the ladder reports (0 when it reports none).
+    fn j_change(&self) -> f64 {
+        self.base
+            .iter()
+            .find(|b| b.name == "j")
+            .map_or(0.0, |b| b.change)
     }
 
     /// (c): the whole-log error never rises (a relative 1e-9 for rounding).
@@ -502,6 +562,37 @@ fn the_ladder_names_the_hidden_effects_of_motulators_logs() {
         &moved,
         moved.is_empty(),
         format!("(e) rs moved beyond 3 % on {} logs", moved.len()),
+    ));
+    // (f)
+    let fans: Vec<String> = outcomes
+        .iter()
+        .filter_map(Outcome::fan_as_viscous)
+        .collect();
+    let head = format!(
+        "(f) logs with a fan carried as a change of B + Bl: {}",
+        fans.len()
+    );
+    failures.extend(bar(
+        &head,
+        &fans,
+        fans.is_empty(),
+        format!("(f) a fan carried as B + Bl on {} logs", fans.len()),
+    ));
+    // (g)
+    let inertia: Vec<String> = outcomes
+        .iter()
+        .filter(|o| o.entry.params.starts_with("kw2p2"))
+        .filter(|o| o.j_change().abs() > J_STILL)
+        .map(|o| format!("{}: j {:+.1} %", o.entry.name, 100.0 * o.j_change()))
+        .collect();
+    failures.extend(bar(
+        &format!(
+            "(g) logs whose file's inertia is exact with j moved beyond 3 %: {}",
+            inertia.len()
+        ),
+        &inertia,
+        inertia.is_empty(),
+        format!("(g) j moved beyond 3 % on {} logs", inertia.len()),
     ));
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

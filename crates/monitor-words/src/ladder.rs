@@ -7,8 +7,8 @@ use crate::analysis::{effect_names, skipped};
 use crate::Spelling;
 use monitor_analysis::effects::{sig, ApartBy, ALPHA_CU_PER_K};
 use monitor_analysis::explain::ladder::{
-    Alike, AsOne, BaseChange, FinalFit, LadderReport, LadderStep, NotSeparable, Refusal,
-    StopReason, TestRule, Tried, WhatIsLeft, WhyNotPhysical, BAND_PERIODS, FLOOR_BAND,
+    Alike, AsOne, BaseChange, FinalFit, InPlace, LadderReport, LadderStep, NotSeparable, Refusal,
+    StopReason, TestRule, Tried, Unsteady, WhatIsLeft, WhyNotPhysical, BAND_PERIODS, FLOOR_BAND,
 };
 use monitor_analysis::fit::machine::BaseKey;
 use monitor_analysis::EffectId;
@@ -288,13 +288,27 @@ pub fn summary(r: &LadderReport) -> String {
 /// that added it ([`as_stepped`]; the whole log's refit's where no step describes it).
 fn found(r: &LadderReport, f: &FinalFit) -> Vec<String> {
     let mut found = Vec::new();
-    if f.base.iter().any(|c| c.changed) {
-        found.push(format!("base parameters: {}", base_changes(&f.base)));
+    if f.base.iter().any(|c| c.changed || c.questioned()) {
+        let beside = if f.ratio_to_floor > r.test_rule.floor_band
+            && f.base.iter().any(|c| c.changed)
+        {
+            format!(
+                " (read beside a model that ends at {:.2}x its noise floor: a law of the model that \
+                 is not the machine's can move them)",
+                f.ratio_to_floor
+            )
+        } else {
+            String::new()
+        };
+        found.push(format!(
+            "base parameters{beside}: {}",
+            base_changes(&f.base)
+        ));
     }
     let dynamics: Vec<&str> = f
         .fitted
         .iter()
-        .filter(|e| e.effect.name().ends_with("_dynamics"))
+        .filter(|e| e.effect.is_dynamics())
         .map(|e| e.effect.name())
         .filter(|k| !r.start.effects.iter().any(|s| s.name() == *k))
         .collect();
@@ -339,7 +353,19 @@ fn as_stepped(r: &LadderReport, id: EffectId) -> Option<&str> {
 /// ...`: a confusable effect of the library fits as well in the place of one of the chosen
 /// model's ([`Alike`]), with why and what would tell them apart.
 pub fn alike(a: &Alike) -> String {
-    let why = match a.apart_by {
+    format!(
+        "{} and {} fit this log alike ({:.2}x and {:.2}x its noise floor): {}",
+        a.effect,
+        a.other,
+        a.ratio,
+        a.ratio_other,
+        apart(a.apart_by)
+    )
+}
+
+/// Why two readings are one on a log, and what kind of log tells them apart ([`ApartBy`]).
+fn apart(by: ApartBy) -> &'static str {
+    match by {
         ApartBy::Reversal => {
             "on a shaft that turns one way a constant torque and dry friction are one torque; \
              a reversal or a run down to standstill tells them apart"
@@ -348,11 +374,12 @@ pub fn alike(a: &Alike) -> String {
             "at one connection a winding's asymmetry and a supply's unbalance add the same \
              negative-sequence current; two supply phases exchanged at the terminals tell them apart"
         }
-    };
-    format!(
-        "{} and {} fit this log alike ({:.2}x and {:.2}x its noise floor): {why}",
-        a.effect, a.other, a.ratio, a.ratio_other
-    )
+        ApartBy::SpeedRange => {
+            "a fan's torque grows with the square of the speed and viscous friction with the \
+             speed, over a narrow range of speed the two are one slope; a start or a run over \
+             a wide range of speed tells them apart"
+        }
+    }
 }
 
 /// `windage and load_torque are one load on this log, not two: ...`: two load laws of the
@@ -416,10 +443,16 @@ pub fn base_changes(c: &[BaseChange]) -> String {
         if let Some(n) = &x.not_separable {
             parts.push(not_separable(x, n));
         }
+        if let Some(p) = &x.in_place {
+            parts.push(in_place(x, p));
+        }
+        if let Some(u) = &x.unsteady {
+            parts.push(unsteady(x, u));
+        }
     }
     let unchanged: Vec<&str> = c
         .iter()
-        .filter(|x| x.identified && !x.changed && x.not_separable.is_none())
+        .filter(|x| x.identified && !x.changed && !x.questioned())
         .filter(|x| !matches!(x.base, BaseKey::Rs | BaseKey::Rr) || parts.is_empty())
         .map(|x| x.base.symbol())
         .collect();
@@ -458,6 +491,46 @@ fn not_separable(x: &BaseChange, n: &NotSeparable) -> String {
         "{} is not separable{from} on this log: without it the model still reaches {:.2}x its noise floor",
         base_change(x),
         n.ratio_without
+    )
+}
+
+/// `B + Bl 0.102 N m s/rad (the file's 0.00501) is not separable from windage on this log:
+/// windage in its place ... reaches 2.44x its noise floor (3.09x with the change); ...`: a
+/// change an effect of the library fits as well in its place ([`InPlace`]), no finding.
+fn in_place(x: &BaseChange, p: &InPlace) -> String {
+    let head = format!(
+        "{} is not separable from {} on this log: {} in its place, with {} at the file's value",
+        base_change(x),
+        p.effect,
+        p.effect,
+        x.base.symbol()
+    );
+    if p.better {
+        return format!(
+            "{head}, fits it better ({:.2}x its noise floor against {:.2}x with the change; {}): \
+             the change is what the model made of {} (the ladder's round judged {} beside the \
+             change, where it added little)",
+            p.ratio_in_place, p.ratio_with_change, p.fitted.summary, p.effect, p.effect
+        );
+    }
+    format!(
+        "{head}, fits it as well ({:.2}x its noise floor against {:.2}x with the change; {}): {}",
+        p.ratio_in_place,
+        p.ratio_with_change,
+        p.fitted.summary,
+        apart(p.apart_by)
+    )
+}
+
+/// `J -9 % (±1 %) is not the same in the log's two halves (-8 % and +9 %): ...`: a change
+/// that moves with the operating point ([`Unsteady`]), no finding.
+fn unsteady(x: &BaseChange, u: &Unsteady) -> String {
+    format!(
+        "{} is not the same in the log's two halves ({:+.0} % and {:+.0} %): it carries what the \
+         model lacks, not a change of the machine",
+        base_change(x),
+        100.0 * u.first,
+        100.0 * u.second
     )
 }
 

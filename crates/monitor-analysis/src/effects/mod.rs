@@ -136,6 +136,10 @@ pub enum ApartBy {
     /// with the winding, a supply's unbalance stays with the supply; at one connection and
     /// one operating point both add the same negative-sequence current.
     SwappedPhases,
+    /// A start, or a run over a wide range of speed: a fan's torque `k w |w|` grows with the
+    /// square of the speed, a viscous `B w` in proportion to it; over a narrow range of
+    /// speed the two are one slope.
+    SpeedRange,
 }
 
 /// Facts measured on the log, beside the fit, that can tell confusable effects apart.

@@ -29,16 +29,29 @@
 //! and it fits the log as well (the same [`AS_ONE_WITHIN`]), the two are said to fit this
 //! log alike, with what would tell them apart ([`Alike`]). The ladder's choice stands (its
 //! values are the ones reported); the other reading is named beside it.
+//!
+//! A base change can stand in for an effect the same way ([`super::rules::IN_PLACE_OF_BASE`]):
+//! a fan's `k w |w|` carried as viscous friction, `B + Bl` twenty times the file's, with the
+//! inertia and the rotor resistance moved beside it to bend `B w` towards `k w²` over the
+//! start. The round that tried windage judged it beside that `B + Bl` and found it removed
+//! little. So the end fits, for each such change, the chosen model with the effect added
+//! and the parameter held at the file's value (one value for one); where the effect's
+//! values are plausible and it fits the log as well (the same test), the change is no
+//! finding, and the effect is named in its place with what tells the two apart ([`InPlace`]).
 
+use super::base::prior_weight;
 use super::climb::Ladder;
-use super::report::{Alike, AsOne};
-use super::rules::AS_ONE_WITHIN;
+use super::report::{Alike, AsOne, InPlace};
+use super::rules::{AS_ONE_WITHIN, IN_PLACE_OF_BASE, STEP_MIN};
 use super::rung::nested_from;
-use crate::analysis::{Analysis, AnalysisError, FittedEffect};
+use crate::analysis::{Analysis, AnalysisError, FittedEffect, MAX_ITER};
 use crate::effects::{sync_speed_mech, EffectModel, LawEffect};
 use crate::fit::machine::MachineFit;
+use crate::fit::machine::{self, BaseKey};
+use crate::metrics::Weights;
 use crate::prep::Prepared;
 use monitor_laws::library::{speed_power, speed_power_nm, SPEED_POWER_REF_RAD_S};
+use monitor_laws::EffectId;
 use std::sync::Arc;
 
 /// Exponents this close to the law's bounds (0 and 5) are the fit's limits, not a reading.
@@ -145,6 +158,71 @@ impl Ladder<'_> {
             }
         }
         Ok(out)
+    }
+
+    /// The library effect that fits the log as well as the chosen model's change of the
+    /// base parameter `key` (the model fitted as `mf` on `fdata`, set up on `an`; whole-log
+    /// `error`, `noise` floor): the model with that effect added and `key` held at the
+    /// file's value, refitted as the final fit is, one value for one
+    /// ([`IN_PLACE_OF_BASE`] lists which effect may stand where; the module doc). `None`
+    /// when none does, or its values there are not plausible.
+    ///
+    /// # Errors
+    /// A model that cannot be set up on the log.
+    pub(super) fn in_place(
+        &self,
+        an: &Analysis,
+        fdata: &Prepared,
+        mf: &MachineFit,
+        key: BaseKey,
+        error: f64,
+        noise: f64,
+    ) -> Result<Option<InPlace>, AnalysisError> {
+        let (rung, sr) = (&self.rung, &self.series);
+        if !(error > 0.0 && noise > 0.0) {
+            return Ok(None);
+        }
+        for (_, kind, apart_by) in IN_PLACE_OF_BASE.iter().filter(|(k, _, _)| *k == key) {
+            let id = EffectId::from(*kind);
+            if rung.models.iter().any(|m| m.kind() == id) {
+                continue;
+            }
+            let Some(other) = self.library.iter().find(|x| x.kind() == id) else {
+                continue;
+            };
+            let mut with: Vec<&dyn EffectModel> = rung.models.clone();
+            let Some(set) = nested_from(an, &with, &mf.effect_params, &[other.as_ref()], fdata)
+            else {
+                continue;
+            };
+            with.push(other.as_ref());
+            let w = Weights::new(fdata, 0, usize::MAX);
+            let pinned = machine::fit_machine_pinned(
+                fdata,
+                &sr.file,
+                &set,
+                &w,
+                &mf.scales,
+                prior_weight(rung.noise),
+                MAX_ITER,
+                Some(key),
+            )?;
+            let whole = self.on_whole_log(&with, &pinned, false)?;
+            let Some(fitted) = whole.fitted.into_iter().find(|f| f.effect == id) else {
+                continue;
+            };
+            if fitted.plausible && as_well(whole.error, error, noise, sr.band.ratio) {
+                return Ok(Some(InPlace {
+                    effect: id,
+                    apart_by: *apart_by,
+                    ratio_with_change: error / noise,
+                    ratio_in_place: whole.error / noise,
+                    better: sr.band.explained(error, whole.error, noise) >= STEP_MIN,
+                    fitted,
+                }));
+            }
+        }
+        Ok(None)
     }
 
     /// The pairs of load laws of speed of the chosen model (fitted as `mf` on `fdata`, its

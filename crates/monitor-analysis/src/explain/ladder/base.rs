@@ -65,6 +65,8 @@ pub fn base_changes(
                 identified,
                 changed: identified && excludes_zero && change.abs() >= BASE_CHANGE_MIN,
                 not_separable: None,
+                unsteady: None,
+                in_place: None,
             }
         })
         .collect()

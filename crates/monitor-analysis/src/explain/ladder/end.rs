@@ -11,7 +11,8 @@
 
 use super::base::{base_changes, prior_weight};
 use super::climb::Ladder;
-use super::report::{FinalFit, NotSeparable};
+use super::report::{BaseChange, FinalFit, NotSeparable, Unsteady};
+use super::rules::UNSTEADY_SHARE;
 use super::rung::{nested_from, setup_list};
 use crate::analysis::{align, Analysis, AnalysisError, FittedEffect, MAX_ITER};
 use crate::effects::EffectModel;
@@ -57,6 +58,17 @@ impl Ladder<'_> {
             for c in base.iter_mut().filter(|c| c.changed) {
                 c.not_separable = self.without_change(&fdata, &set, &mf, c.base, error, noise)?;
                 c.changed = c.not_separable.is_none();
+            }
+            for c in base.iter_mut().filter(|c| c.changed) {
+                c.in_place = self.in_place(&an, &fdata, &mf, c.base, error, noise)?;
+                c.changed = c.in_place.is_none();
+            }
+            if base.iter().any(|c| c.changed) {
+                let halves = self.halves(&fdata, &set, &mf)?;
+                for c in base.iter_mut().filter(|c| c.changed) {
+                    c.unsteady = unsteady(c, &halves);
+                    c.changed = c.unsteady.is_none();
+                }
             }
         }
         let as_one = self.as_one(&an, &fdata, &mf, error, noise)?;
@@ -182,6 +194,41 @@ impl Ladder<'_> {
         }))
     }
 
+    /// The base changes of the chosen model (its effects set up as `set`, fitted as `mf` on
+    /// `fdata`) read on each half of the series alone (by samples: the model still runs
+    /// over the whole series, only the half's samples weigh), each with its 95 %
+    /// half-widths on that half: the readings [`unsteady`] compares.
+    ///
+    /// # Errors
+    /// A model that cannot be set up on the log.
+    fn halves(
+        &self,
+        fdata: &Prepared,
+        set: &[ActiveEffect<'_>],
+        mf: &MachineFit,
+    ) -> Result<[Vec<BaseChange>; 2], AnalysisError> {
+        let (rung, sr) = (&self.rung, &self.series);
+        let n = fdata.len();
+        let half = |lo: usize, hi: usize| -> Result<Vec<BaseChange>, AnalysisError> {
+            let mut w = Weights::new(fdata, 0, usize::MAX);
+            for (k, t) in w.train.iter_mut().enumerate() {
+                *t = (lo..hi).contains(&k);
+            }
+            let f = machine::fit_machine(
+                fdata,
+                &sr.file,
+                set,
+                &w,
+                &mf.scales,
+                prior_weight(rung.noise),
+                MAX_ITER,
+            )?;
+            let h = machine::machine_half_widths(fdata, &sr.file, set, &w, &f)?;
+            Ok(base_changes(&f.scales, &sr.file, &h))
+        };
+        Ok([half(0, n / 2)?, half(n / 2, n)?])
+    }
+
     /// The model of the rung the ladder stopped on (its effects set up as `set`; `an` the
     /// analysis of its base) fitted on `fdata` from the last step's values: with the six
     /// base parameters free beside its effects ([`machine::fit_machine`], their 95 %
@@ -228,10 +275,80 @@ impl Ladder<'_> {
     }
 }
 
+/// The change `c` as [`Unsteady`] when its readings on the log's two halves (`halves`,
+/// [`Ladder::halves`]) differ by more than both halves' 95 % intervals together and by more
+/// than [`UNSTEADY_SHARE`] of the change itself; `None` when they agree, or when a half
+/// does not determine it (no interval: that half cannot judge).
+fn unsteady(c: &BaseChange, halves: &[Vec<BaseChange>; 2]) -> Option<Unsteady> {
+    let [a, b] = [&halves[0], &halves[1]].map(|h| h.iter().find(|x| x.base == c.base));
+    let (a, b) = (a?, b?);
+    let ([alo, ahi], [blo, bhi]) = (a.interval?, b.interval?);
+    let together = (0.5 * (ahi - alo)).hypot(0.5 * (bhi - blo));
+    let apart = (a.change - b.change).abs();
+    (apart > together && apart > UNSTEADY_SHARE * c.change.abs()).then_some(Unsteady {
+        first: a.change,
+        second: b.change,
+    })
+}
+
 /// True when an effect's values `a` and `b` differ by more than 0.5 % of the larger (a
 /// value that carries what the pinned base parameter did).
 fn moved(a: &[f64], b: &[f64]) -> bool {
     a.iter()
         .zip(b)
         .any(|(x, y)| (x - y).abs() > 0.005 * x.abs().max(y.abs()).max(1e-12))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A change of `key` read as `change` with the 95 % half-width `half`.
+    fn read(key: BaseKey, change: f64, half: Option<f64>) -> BaseChange {
+        BaseChange {
+            base: key,
+            change,
+            interval: half.map(|h| [change - h, change + h]),
+            file_value: 1.0,
+            value: 1.0 + change,
+            unit: "",
+            identified: true,
+            changed: true,
+            not_separable: None,
+            unsteady: None,
+            in_place: None,
+        }
+    }
+
+    /// The fan's inertia (-9 % on the whole log: -8 % on the half with the start, +9 % on
+    /// the other, each known to 1-2 %) is unsteady; a warm stator's Rs (+19.8 % and
+    /// +18.6 %, apart by more than their intervals but by a sixteenth of the change) is not;
+    /// nor is a change a half cannot determine.
+    #[test]
+    fn a_change_that_moves_between_the_halves_is_unsteady() {
+        let j = read(BaseKey::J, -0.09, Some(0.005));
+        let halves = [
+            vec![read(BaseKey::J, -0.08, Some(0.007))],
+            vec![read(BaseKey::J, 0.09, Some(0.016))],
+        ];
+        let u = unsteady(&j, &halves).expect("the inertia moves between the halves");
+        assert_eq!((u.first, u.second), (-0.08, 0.09));
+        let rs = read(BaseKey::Rs, 0.19, Some(0.0004));
+        let halves = [
+            vec![read(BaseKey::Rs, 0.198, Some(0.0005))],
+            vec![read(BaseKey::Rs, 0.186, Some(0.002))],
+        ];
+        assert!(unsteady(&rs, &halves).is_none());
+        let halves = [
+            vec![read(BaseKey::J, -0.08, None)],
+            vec![read(BaseKey::J, 0.09, Some(0.016))],
+        ];
+        assert!(unsteady(&j, &halves).is_none());
+        // Apart by less than the two intervals together: the halves agree.
+        let halves = [
+            vec![read(BaseKey::J, -0.08, Some(0.15))],
+            vec![read(BaseKey::J, 0.05, Some(0.05))],
+        ];
+        assert!(unsteady(&j, &halves).is_none());
+    }
 }

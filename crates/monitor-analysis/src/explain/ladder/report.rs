@@ -240,6 +240,61 @@ pub struct BaseChange {
     /// log and is no finding.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub not_separable: Option<NotSeparable>,
+    /// The change the fit reads on the whole log differs between the log's two halves
+    /// (the ladder's end, `Ladder::halves`): not a constant of the machine, so no finding.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unsteady: Option<Unsteady>,
+    /// A library effect outside the chosen model fits the log as well with the parameter
+    /// at the file's value (the ladder's end, `Ladder::in_place`): the log cannot tell the
+    /// change from that effect, so no finding.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub in_place: Option<InPlace>,
+}
+
+impl BaseChange {
+    /// True when the ladder's end found the change not to be the log's own evidence: it
+    /// trades with the effects' values ([`NotSeparable`]), it differs between the log's
+    /// halves ([`Unsteady`]), or an effect fits as well in its place ([`InPlace`]).
+    pub fn questioned(&self) -> bool {
+        self.not_separable.is_some() || self.unsteady.is_some() || self.in_place.is_some()
+    }
+}
+
+/// A base change that is not the same in the log's two halves (JSON
+/// `base_changes[].unsteady`, `final_fit.base[].unsteady`): the chosen model refitted with
+/// the base parameters free on each half of the working series alone (by samples). A
+/// machine's parameter is one value over a log; a change that moves by more than both
+/// halves' 95 % intervals together and by more than half of itself carries what the model
+/// lacks (a law whose shape is not the machine's), not a change of the machine.
+#[derive(Debug, Clone, Serialize)]
+pub struct Unsteady {
+    /// The change read on the first half (relative, as [`BaseChange::change`]).
+    pub first: f64,
+    /// The change read on the second half.
+    pub second: f64,
+}
+
+/// A library effect that fits the log as well as a base change does (JSON
+/// `base_changes[].in_place`, `final_fit.base[].in_place`): the chosen model with that
+/// effect added and the parameter held at the file's value, refitted as the final fit is
+/// (one value for one: no more freedom than the change).
+#[derive(Debug, Clone, Serialize)]
+pub struct InPlace {
+    /// The effect that fits in the change's place.
+    pub effect: EffectId,
+    /// What kind of log tells the two apart.
+    pub apart_by: ApartBy,
+    /// The chosen model's whole-log error over its noise floor (with the change).
+    pub ratio_with_change: f64,
+    /// The same with the effect in the change's place.
+    pub ratio_in_place: f64,
+    /// True when the effect in the change's place removes at least
+    /// [`super::rules::STEP_MIN`] of the error beyond the floor the change leaves: the log
+    /// reads the effect better than the change (a log with a start and a fan), not only as
+    /// well.
+    pub better: bool,
+    /// The effect's values in the change's place, as the effect states them.
+    pub fitted: FittedEffect,
 }
 
 /// A base change the log cannot tell from the effects' values (JSON

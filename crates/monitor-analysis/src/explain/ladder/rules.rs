@@ -23,7 +23,10 @@
 //! effect-free control logs of the test matrix (a textbook machine written inside the test,
 //! three sizes, starts and steps: under 10 %), doubled (docs/model-vs-measurement.md).
 
+use crate::effects::ApartBy;
 use crate::explain::NOISE_MARGIN;
+use crate::fit::machine::BaseKey;
+use monitor_core::effect::EffectKind;
 
 /// A step must remove at least this share (10 %) of the held-back error beyond the noise
 /// floor that the model had before it (this module's doc, "The test a step passes").
@@ -137,3 +140,19 @@ pub const BASE_CHANGE_MIN: f64 = 0.03;
 /// confusable partner than the chosen effect, `apart.rs`) and still be said to fit the log
 /// as well (10 %: the pair's two parameters against the one law's two, on the same fit).
 pub const AS_ONE_WITHIN: f64 = 0.10;
+
+/// The library effects a base change may stand in for, with what tells the two apart
+/// (`end.rs`, `Ladder::in_place`): a fan's torque `k w |w|` carried as viscous friction
+/// `B + Bl` (a fan's log read B + Bl 20 times the file's, the inertia -9 % and the rotor
+/// resistance beside it to bend `B w` into `k w²` over the start; windage in its place,
+/// with B + Bl at the file's value, fitted the log better: 2.44x its floor against 3.09x).
+pub const IN_PLACE_OF_BASE: [(BaseKey, EffectKind, ApartBy); 1] =
+    [(BaseKey::B, EffectKind::Windage, ApartBy::SpeedRange)];
+
+/// A change is [`super::report::Unsteady`] when its two halves' readings differ by more
+/// than both halves' 95 % intervals together and by more than this share (one half) of the
+/// change itself: on logs whose model is complete the halves agree within a few per cent
+/// of the change (a warm stator's Rs +19.8 % and +18.6 %), while a change that carries a
+/// law's shortfall moves with the operating point (the inertia of a fan's log read beside
+/// viscous friction in place of the fan: -8 % on the half with the start, +9 % on the other).
+pub const UNSTEADY_SHARE: f64 = 0.5;
