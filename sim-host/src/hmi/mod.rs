@@ -442,6 +442,17 @@ pub fn header_of(
     candidates: &[(Fault, f32)],
     isolation: Option<&IsolationView>,
 ) -> String {
+    header_words(state, candidates, isolation, true)
+}
+
+/// [`header_of`], the word FAULT left out of a fault's state where `fault_word` is false
+/// (the lamp's word stands beside it: [`lamp_and_header`]).
+fn header_words(
+    state: &MonitorState,
+    candidates: &[(Fault, f32)],
+    isolation: Option<&IsolationView>,
+    fault_word: bool,
+) -> String {
     let named = isolation.filter(|i| i.named.is_some());
     match (named, state) {
         (Some(iso), MonitorState::Fault(_)) => iso.text(),
@@ -451,7 +462,7 @@ pub fn header_of(
             monitor_api::words::diagnose::moved_why(note)
         ),
         (Some(iso), _) => format!("{} | named: {}", state_text(state, candidates), iso.text()),
-        (None, _) => state_text(state, candidates),
+        (None, _) => state_words(state, candidates, fault_word),
     }
 }
 
@@ -468,7 +479,6 @@ pub fn lamp_and_header(
     candidates: &[(Fault, f32)],
     isolation: Option<&IsolationView>,
 ) -> (&'static str, String) {
-    let header = header_of(state, candidates, isolation);
     let lamp = match (state, fault_lamp, call) {
         (MonitorState::Moved(_), _, _) => "MOVED",
         (_, true, _) => "FAULT",
@@ -481,16 +491,20 @@ pub fn lamp_and_header(
         }
         (_, false, _) => "",
     };
-    // The lamp's word once: a state that begins with it loses it.
-    let text = match header.strip_prefix("FAULT ") {
-        Some(rest) if !lamp.is_empty() => rest.to_string(),
-        _ => header,
-    };
-    (lamp, text)
+    // The lamp's word once: beside a lamp's word a fault's state is spelled without it.
+    (
+        lamp,
+        header_words(state, candidates, isolation, lamp.is_empty()),
+    )
 }
 
 /// The monitor's state in words (the screen and the plain-text line).
 pub fn state_text(state: &MonitorState, candidates: &[(Fault, f32)]) -> String {
+    state_words(state, candidates, true)
+}
+
+/// [`state_text`], a fault's state without the word FAULT where `fault_word` is false.
+fn state_words(state: &MonitorState, candidates: &[(Fault, f32)], fault_word: bool) -> String {
     match state {
         MonitorState::Commissioning(x) => format!("commissioning {:.0} %", x * 100.0),
         MonitorState::Transient => "transient (lamps hold)".to_string(),
@@ -500,7 +514,11 @@ pub fn state_text(state: &MonitorState, candidates: &[(Fault, f32)]) -> String {
             let sig = monitor_studies::fault_signatures::signature_text(
                 candidates.iter().map(|(f, p)| (*f, *p)),
             );
-            format!("FAULT ({sig})")
+            if fault_word {
+                format!("FAULT ({sig})")
+            } else {
+                format!("({sig})")
+            }
         }
         MonitorState::Moved(note) => format!(
             "operating point moved: {}",

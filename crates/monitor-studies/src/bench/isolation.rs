@@ -322,7 +322,11 @@ fn wrong_names(row: &Table1Row, f: Fault, want: IsolationName) -> Vec<String> {
     for c in &row.isolation_candidates {
         let ok = c.fault == f || (friction && matches!(c.fault, Fault::B | Fault::Bl));
         let (name, p) = (c.fault, c.probability);
-        if p >= 0.5 && !ok && !wrong.iter().any(|w| w.starts_with(&format!("{name} "))) {
+        let given = row
+            .names_given
+            .iter()
+            .any(|g| g.name != want && g.name == IsolationName::Fault(name));
+        if p >= 0.5 && !ok && !given {
             wrong.push(format!("{name} p={p:.2} at the end"));
         }
     }
