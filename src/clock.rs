@@ -270,4 +270,25 @@ mod tests {
         assert_eq!(pll_fields(ClockSource::Hse), hse);
         assert_eq!(pll_fields(ClockSource::Hsi), PllFields { m: 3, ..hse });
     }
+
+    /// The time base's error by source: the crystal's 50 ppm (the assumption above), the
+    /// HSI's +-1 % over temperature (the datasheet: 10 000 ppm), after a crystal failure too.
+    #[test]
+    fn the_time_bases_error_is_its_sources() {
+        assert_eq!(ClockSource::Hse.error_ppm(), 50);
+        assert_eq!(ClockSource::Hsi.error_ppm(), 10_000);
+        assert_eq!(ClockSource::HsiAfterFailure.error_ppm(), 10_000);
+    }
+
+    /// The boot log's names tell the three sources apart and say why the HSI runs.
+    #[test]
+    fn each_source_is_named_with_why_it_runs() {
+        assert!(ClockSource::Hse.name().contains("crystal (HSE)"));
+        let hsi = ClockSource::Hsi.name();
+        assert!(hsi.contains("(HSI, +-1 %)"), "{hsi}");
+        assert!(hsi.contains("did not start"), "{hsi}");
+        let after = ClockSource::HsiAfterFailure.name();
+        assert!(after.contains("(HSI, +-1 %)"), "{after}");
+        assert!(after.contains("failed in the previous run"), "{after}");
+    }
 }

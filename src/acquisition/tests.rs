@@ -149,6 +149,25 @@ fn the_check_two_at_a_time_is_the_range_test_of_each_conversion() {
     );
     assert!(!sum_clipped(&[4095; HALF_LEN], &wide).1);
     assert!(sum_clipped(&[0; HALF_LEN], &wide).1);
+    // A low beyond 12 bits: every code is at or below it, so every conversion of its
+    // channel clips, mid-scale too, in both of the channel's word positions.
+    for low in [0x8000, 0x9000, u16::MAX] {
+        let high = u16::MAX;
+        for channel in 0..CHANNELS {
+            let mut ranges = [LinearRange::RAILS; CHANNELS];
+            ranges[channel] = LinearRange { low, high };
+            let limits = ClipLimits::new(&ranges);
+            for code in [0u16, 1, 2048, 4094, 4095] {
+                assert!(ranges[channel].clips(code), "low {low:#x} code {code}");
+                let mut half = [2048u16; HALF_LEN];
+                for c in half.iter_mut().skip(channel).step_by(CHANNELS) {
+                    *c = code;
+                }
+                let clipped = sum_clipped(&half, &limits).1;
+                assert!(clipped, "low {low:#x} channel {channel} code {code}");
+            }
+        }
+    }
 }
 
 /// A clip is held through the filter's memory: the clipped sample and the 16 after it.
@@ -345,6 +364,29 @@ fn the_filter_keeps_the_fundamental_and_takes_the_ripple_out() {
         "{peak} against {expected}"
     );
     assert_eq!(out_ripple.len(), 2_000);
+}
+
+/// The filter's first sample starts its stages at that sample's value, no run-up from zero
+/// (mid-scale is kept exactly), and the held-back count at that sample's count; with
+/// `step` and with `step_portable` (the Rust alone, which `cargo qemu-core` checks the
+/// board's Thumb-2 kernel against).
+#[test]
+fn the_filter_starts_at_its_first_sample() {
+    let mid = 2048 * OVERSAMPLING as u32;
+    for portable in [false, true] {
+        let mut f = PwmFilter::new(10_000, 50.0);
+        for k in 0..2 * ENCODER_DELAY_SAMPLES as u16 {
+            let (v, i, count) = if portable {
+                f.step_portable([mid; CHANNELS], [mid; CHANNELS], 100 + k)
+            } else {
+                f.step([mid; CHANNELS], [mid; CHANNELS], 100 + k)
+            };
+            let codes = ([2048; CHANNELS], [2048; CHANNELS]);
+            assert_eq!((v, i), codes, "sample {k}, portable {portable}");
+            let held = k.saturating_sub(ENCODER_DELAY_SAMPLES as u16);
+            assert_eq!(count, 100 + held, "sample {k}, portable {portable}");
+        }
+    }
 }
 
 /// A sinusoid at a multiple of the sample rate (what folds onto DC and the
