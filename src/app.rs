@@ -63,6 +63,8 @@ pub const DEFAULT_MACHINE: ReferenceMachine = monitor_core::reference::MOTOR_2P2
 pub const PANEL_PERIOD_MS: u32 = 50;
 /// Independent watchdog timeout, ms: the MCU resets this long after the last pet.
 pub const WATCHDOG_TIMEOUT_MS: u32 = 500;
+// The boot's first timeout is the longer: the running one is set once thread mode runs.
+const _: () = assert!(crate::watchdog::BOOT_TIMEOUT_MS > WATCHDOG_TIMEOUT_MS);
 /// How long the panel shows "monitor failed" after a reset by a panic, a stalled sample
 /// path or a hang, ms.
 pub const FAILED_BOOT_SHOW_MS: u32 = 5_000;

@@ -9,7 +9,7 @@
 //!    `monitor-studies`, `monitor-api`, `monitor-store`): a module uses only modules of a
 //!    lower layer of its crate; a module the table does not list is in the crate's base
 //!    layer. Checked on every `use` and every path (`crate::`, `super::`, `self::`), tests
-//!    inside `src/` included. docs/architecture.md names every crate of `crates/`. No two
+//!    inside `src/` and the paths inside a macro's body (read from its tokens) included. docs/architecture.md names every crate of `crates/`. No two
 //!    files of a crate reach each other (an import circle), but a module and its own
 //!    submodules and the circles of [`CIRCLES_LEFT`]: checked in every package of the
 //!    workspace (each tracked `Cargo.toml`) with more than one file in `src/`, on the

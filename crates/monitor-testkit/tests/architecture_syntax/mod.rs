@@ -124,6 +124,72 @@ impl<'ast> Visit<'ast> for Paths {
         }
         syn::visit::visit_path(self, p);
     }
+
+    /// A macro's body is tokens, not syntax `syn` walks: its paths (`crate::a::f` in a
+    /// `format!`'s arguments, a `use` a macro expands) are read from the tokens, each run of
+    /// names joined by `::` one path.
+    fn visit_macro(&mut self, m: &'ast syn::Macro) {
+        self.tokens(m.tokens.clone());
+        syn::visit::visit_macro(self, m);
+    }
+}
+
+impl Paths {
+    /// Every run `a::b::c` of names in `tokens` (and in its groups) as a path.
+    fn tokens(&mut self, tokens: proc_macro2::TokenStream) {
+        use proc_macro2::{Spacing, TokenTree};
+        let mut run: Vec<String> = Vec::new();
+        let mut line = 0;
+        let mut colons = 0;
+        let mut after_colon = false;
+        let flush = |me: &mut Self, run: &mut Vec<String>, line: usize| {
+            if !run.is_empty() {
+                me.push(std::mem::take(run), line, None);
+            }
+        };
+        for t in tokens {
+            match t {
+                TokenTree::Ident(i) => {
+                    if colons != 2 {
+                        flush(self, &mut run, line);
+                        after_colon = false;
+                    }
+                    if run.is_empty() {
+                        line = i.span().start().line;
+                        if after_colon {
+                            // `::a` (a leading colon): an external crate's path.
+                            after_colon = false;
+                            colons = 0;
+                            continue;
+                        }
+                    }
+                    run.push(i.to_string());
+                    colons = 0;
+                }
+                TokenTree::Punct(p) if p.as_char() == ':' => {
+                    colons += 1;
+                    if run.is_empty() && colons == 2 {
+                        after_colon = true;
+                    }
+                    if p.spacing() == Spacing::Alone && colons == 1 {
+                        flush(self, &mut run, line);
+                        colons = 0;
+                    }
+                }
+                TokenTree::Group(g) => {
+                    flush(self, &mut run, line);
+                    colons = 0;
+                    self.tokens(g.stream());
+                }
+                _ => {
+                    flush(self, &mut run, line);
+                    colons = 0;
+                    after_colon = false;
+                }
+            }
+        }
+        flush(self, &mut run, line);
+    }
 }
 
 /// The top-level module a path of a file in module `module` reaches in its own crate, if
@@ -212,4 +278,23 @@ impl<'ast> Visit<'ast> for LongFunctions<'_> {
             syn::visit::visit_item_impl(self, i);
         }
     }
+}
+
+/// A path inside a macro's body is read (a circle made in a `format!`'s arguments is one),
+/// and a path with a leading `::` (another crate's) is not a path of the crate.
+#[test]
+fn the_paths_inside_a_macro_are_read() {
+    let file: syn::File =
+        syn::parse_str("fn f() { format!(\"{}\", crate::hmi::g(::other::x, super::y::Z)); }")
+            .unwrap();
+    let found: Vec<Vec<String>> = Paths::of(&file, vec!["log".into()])
+        .into_iter()
+        .map(|u| u.segments)
+        .filter(|s| s.len() > 1)
+        .collect();
+    let want: Vec<Vec<String>> = [&["crate", "hmi", "g"][..], &["super", "y", "Z"]]
+        .iter()
+        .map(|p| p.iter().map(|x| x.to_string()).collect())
+        .collect();
+    assert_eq!(found, want);
 }

@@ -247,7 +247,7 @@ pub fn brief(u: &UnbalanceReport, against: Against, sp: &dyn Spelling) -> String
     } else {
         format!(
             "winding {}",
-            super::verdict::against_text(FindingSource::Winding, against)
+            super::named::against_text(FindingSource::Winding, against)
         )
     };
     match u.shorted_turns_reach.filter(|_| watched(u).is_none()) {
