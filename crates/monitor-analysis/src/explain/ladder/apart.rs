@@ -39,15 +39,14 @@
 //! values are plausible and it fits the log as well (the same test), the change is no
 //! finding, and the effect is named in its place with what tells the two apart ([`InPlace`]).
 
-use super::base::prior_weight;
 use super::climb::Ladder;
 use super::report::{Alike, AsOne, InPlace};
 use super::rules::{AS_ONE_WITHIN, IN_PLACE_OF_BASE, STEP_MIN};
 use super::rung::nested_from;
-use crate::analysis::{Analysis, AnalysisError, FittedEffect, MAX_ITER};
+use crate::analysis::{Analysis, AnalysisError, FittedEffect};
 use crate::effects::{sync_speed_mech, EffectModel, LawEffect};
+use crate::fit::machine::BaseKey;
 use crate::fit::machine::MachineFit;
-use crate::fit::machine::{self, BaseKey};
 use crate::metrics::Weights;
 use crate::prep::Prepared;
 use monitor_laws::library::{speed_power, speed_power_nm, SPEED_POWER_REF_RAD_S};
@@ -197,16 +196,7 @@ impl Ladder<'_> {
             };
             with.push(other.as_ref());
             let w = Weights::new(fdata, 0, usize::MAX);
-            let pinned = machine::fit_machine_pinned(
-                fdata,
-                &sr.file,
-                &set,
-                &w,
-                &mf.scales,
-                prior_weight(rung.noise),
-                MAX_ITER,
-                Some(key),
-            )?;
+            let pinned = self.refit_from(fdata, &set, mf, &w, Some(key))?;
             let whole = self.on_whole_log(&with, &pinned, false)?;
             let Some(fitted) = whole.fitted.into_iter().find(|f| f.effect == id) else {
                 continue;

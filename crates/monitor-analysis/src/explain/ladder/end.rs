@@ -160,16 +160,7 @@ impl Ladder<'_> {
     ) -> Result<Option<NotSeparable>, AnalysisError> {
         let (rung, sr) = (&self.rung, &self.series);
         let w = Weights::new(fdata, 0, usize::MAX);
-        let pinned = machine::fit_machine_pinned(
-            fdata,
-            &sr.file,
-            set,
-            &w,
-            &mf.scales,
-            prior_weight(rung.noise),
-            MAX_ITER,
-            Some(key),
-        )?;
+        let pinned = self.refit_from(fdata, set, mf, &w, Some(key))?;
         let e_pin = self.on_whole_log(&rung.models, &pinned, false)?.error;
         let removes = if e_pin > noise {
             (e_pin - error) / (e_pin - noise)
@@ -207,26 +198,45 @@ impl Ladder<'_> {
         set: &[ActiveEffect<'_>],
         mf: &MachineFit,
     ) -> Result<[Vec<BaseChange>; 2], AnalysisError> {
-        let (rung, sr) = (&self.rung, &self.series);
+        let sr = &self.series;
         let n = fdata.len();
         let half = |lo: usize, hi: usize| -> Result<Vec<BaseChange>, AnalysisError> {
             let mut w = Weights::new(fdata, 0, usize::MAX);
             for (k, t) in w.train.iter_mut().enumerate() {
                 *t = (lo..hi).contains(&k);
             }
-            let f = machine::fit_machine(
-                fdata,
-                &sr.file,
-                set,
-                &w,
-                &mf.scales,
-                prior_weight(rung.noise),
-                MAX_ITER,
-            )?;
+            let f = self.refit_from(fdata, set, mf, &w, None)?;
             let h = machine::machine_half_widths(fdata, &sr.file, set, &w, &f)?;
             Ok(base_changes(&f.scales, &sr.file, &h))
         };
         Ok([half(0, n / 2)?, half(n / 2, n)?])
+    }
+
+    /// The model of the effects `set` refitted as the final fit is, from the fit `mf`, on
+    /// the training samples of `w`, with the base parameter `pin` (if any) held at the
+    /// file's value ([`machine::fit_machine_pinned`]).
+    ///
+    /// # Errors
+    /// An effect that refuses its set-up's values.
+    pub(super) fn refit_from(
+        &self,
+        fdata: &Prepared,
+        set: &[ActiveEffect<'_>],
+        mf: &MachineFit,
+        w: &Weights,
+        pin: Option<BaseKey>,
+    ) -> Result<MachineFit, AnalysisError> {
+        let (rung, sr) = (&self.rung, &self.series);
+        Ok(machine::fit_machine_pinned(
+            fdata,
+            &sr.file,
+            set,
+            w,
+            &mf.scales,
+            prior_weight(rung.noise),
+            MAX_ITER,
+            pin,
+        )?)
     }
 
     /// The model of the rung the ladder stopped on (its effects set up as `set`; `an` the
