@@ -289,9 +289,7 @@ pub fn summary(r: &LadderReport) -> String {
 fn found(r: &LadderReport, f: &FinalFit) -> Vec<String> {
     let mut found = Vec::new();
     if f.base.iter().any(|c| c.changed || c.questioned()) {
-        let beside = if f.ratio_to_floor > r.test_rule.floor_band
-            && f.base.iter().any(|c| c.changed)
-        {
+        let beside = if f.far_from_floor && f.base.iter().any(|c| c.changed) {
             format!(
                 " (read beside a model that ends at {:.2}x its noise floor: a law of the model that \
                  is not the machine's can move them)",

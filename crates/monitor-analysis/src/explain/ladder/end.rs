@@ -12,7 +12,7 @@
 use super::base::{base_changes, prior_weight};
 use super::climb::Ladder;
 use super::report::{BaseChange, FinalFit, NotSeparable, Unsteady};
-use super::rules::UNSTEADY_SHARE;
+use super::rules::{PAIRS_ABOVE, UNSTEADY_SHARE};
 use super::rung::{nested_from, setup_list};
 use crate::analysis::{align, Analysis, AnalysisError, FittedEffect, MAX_ITER};
 use crate::effects::EffectModel;
@@ -79,6 +79,7 @@ impl Ladder<'_> {
             noise_floor: noise,
             ratio_to_floor: error / noise,
             below_start: start_error / error,
+            far_from_floor: error / noise > PAIRS_ABOVE,
             base,
             fitted: whole.fitted,
             as_one,

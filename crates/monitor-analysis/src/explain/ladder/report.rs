@@ -326,6 +326,12 @@ pub struct FinalFit {
     pub ratio_to_floor: f64,
     /// The start's error over this one.
     pub below_start: f64,
+    /// True when the model ends far from its noise floor (more than
+    /// [`super::rules::PAIRS_ABOVE`], 2x): its base changes are read beside a model that
+    /// leaves most of the error beyond the noise unexplained, where a law of the model that
+    /// is not the machine's can move them (motulator's saturating machine: Rr -25 % beside
+    /// the library's saturation law, at 3.09x).
+    pub far_from_floor: bool,
     /// The six base parameters against the user's file, with their intervals.
     pub base: Vec<BaseChange>,
     /// The effects with their values.
