@@ -14,7 +14,8 @@
 //!   J domega_m/dt = T_e - B omega_m - T_load,       dtheta_m/dt = omega_m
 //! ```
 //! Star connection with isolated neutral (no zero-sequence current). Supply: stiff source,
-//! v_s = V e^{j theta_e} (+ negative sequence with `supply_unbalance`), V = sqrt(2/3) V_ll,rms,
+//! v_s = V e^{j theta_e} (+ negative sequence with `supply_unbalance`, + the voltage
+//! harmonics of `[supply] harmonics`, each in the sequence of its order), V = sqrt(2/3) V_ll,rms,
 //! theta_e continuous across frequency steps. Load: `viscous` T_load = Bl omega_m (the
 //! paper) or `torque` T_load = T(t) (an active torque, also at standstill), plus
 //! `coulomb_friction` and `windage` when enabled.
@@ -108,8 +109,8 @@ mod thermometer;
 pub use effect_spec::EffectSpec;
 pub use faults::{FaultSpec, SensorFaultMode};
 pub use scenario::{
-    LoadKind, LoadSpec, LoadStep, Scenario, SupplySpec, SupplyStep, UserLaws, Workload,
-    DEFAULT_MAX_STEP_S, MIN_STEP_S, SAMPLE_RATE_RANGE_HZ,
+    LoadKind, LoadSpec, LoadStep, Scenario, SupplyHarmonic, SupplySpec, SupplyStep, UserLaws,
+    Workload, DEFAULT_MAX_STEP_S, MIN_STEP_S, SAMPLE_RATE_RANGE_HZ,
 };
 pub use sensors::SensorSpec;
 pub use steady::{

@@ -14,7 +14,8 @@ use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
 /// The stiff supply: positive-sequence unit phasor `p`, rotated by `e^{j we h/2}` twice per
-/// integrator step (no trig per step), plus a negative sequence with `supply_unbalance`.
+/// integrator step (no trig per step), plus a negative sequence with `supply_unbalance`
+/// and the scenario's voltage harmonics ([`Harmonic`]).
 struct Supply {
     vpk0: f64,
     vpk: f64,
@@ -26,10 +27,64 @@ struct Supply {
     sn: f64,
     p: [f64; 2],
     rot: [f64; 2],
+    harmonics: Vec<Harmonic>,
+}
+
+/// A voltage harmonic of the supply ([`crate::SupplyHarmonic`]): `p^n e^{j phi}` times
+/// `k` for a positive-sequence order, its conjugate for a negative-sequence one (the
+/// phase voltages `k cos(n theta + phi - m n 2 pi / 3)`, m = 0, 1, 2, in the alpha-beta
+/// frame).
+#[derive(Debug, Clone, Copy)]
+struct Harmonic {
+    n: u32,
+    positive: bool,
+    k: f64,
+    /// e^{j phi}.
+    c: f64,
+    s: f64,
+}
+
+impl Harmonic {
+    fn of(h: &crate::SupplyHarmonic) -> Self {
+        let (s, c) = h.phase_deg.to_radians().sin_cos();
+        Harmonic {
+            n: h.order,
+            positive: h.positive_sequence(),
+            k: h.fraction,
+            c,
+            s,
+        }
+    }
+
+    /// The harmonic's unit-amplitude vector times `k` at the fundamental's unit phasor `p`.
+    #[inline(always)]
+    fn at(&self, p: [f64; 2]) -> [f64; 2] {
+        let mut pn = [1.0, 0.0];
+        let (mut base, mut e) = (p, self.n);
+        while e > 0 {
+            if e & 1 == 1 {
+                pn = Supply::rotate(pn, base);
+            }
+            base = Supply::rotate(base, base);
+            e >>= 1;
+        }
+        let [x, y] = Supply::rotate(pn, [self.c, self.s]);
+        if self.positive {
+            [self.k * x, self.k * y]
+        } else {
+            [self.k * x, -self.k * y]
+        }
+    }
 }
 
 impl Supply {
-    fn new(vpk0: f64, we0: f64, h: f64, unbalance: Option<(f64, f64)>) -> Self {
+    fn new(
+        vpk0: f64,
+        we0: f64,
+        h: f64,
+        unbalance: Option<(f64, f64)>,
+        harmonics: &[crate::SupplyHarmonic],
+    ) -> Self {
         let (kn, cn, sn) = match unbalance {
             Some((k, phi)) => (k, phi.cos(), phi.sin()),
             None => (0.0, 1.0, 0.0),
@@ -44,6 +99,7 @@ impl Supply {
             sn,
             p: [1.0, 0.0],
             rot: [(0.5 * we0 * h).cos(), (0.5 * we0 * h).sin()],
+            harmonics: harmonics.iter().map(Harmonic::of).collect(),
         }
     }
 
@@ -64,10 +120,15 @@ impl Supply {
     #[inline(always)]
     fn voltage(&self, p: [f64; 2]) -> [f64; 2] {
         let (kn, cn, sn) = (self.kn, self.cn, self.sn);
-        [
-            self.vpk * (p[0] + kn * (cn * p[0] + sn * p[1])),
-            self.vpk * (p[1] + kn * (sn * p[0] - cn * p[1])),
-        ]
+        let mut v = [
+            p[0] + kn * (cn * p[0] + sn * p[1]),
+            p[1] + kn * (sn * p[0] - cn * p[1]),
+        ];
+        for h in &self.harmonics {
+            let [x, y] = h.at(p);
+            v = [v[0] + x, v[1] + y];
+        }
+        [self.vpk * v[0], self.vpk * v[1]]
     }
 
     #[inline(always)]
@@ -312,7 +373,13 @@ impl<'a> SimRun<'a> {
             scenario.seed,
         );
         let h = dt / f64::from(nsub);
-        let supply = Supply::new(rated.vpk0, rated.we0, h, builder.eff.unbalance);
+        let supply = Supply::new(
+            rated.vpk0,
+            rated.we0,
+            h,
+            builder.eff.unbalance,
+            &scenario.supply.harmonics,
+        );
         Ok(SimRun {
             scenario,
             builder,

@@ -117,6 +117,36 @@ pub struct SupplySpec {
     /// Steps, applied at the first output sample at or after `t_s`, phase-continuous.
     #[serde(default)]
     pub steps: Vec<SupplyStep>,
+    /// Voltage harmonics of the supply (a grid's 5th and 7th, a few per cent each),
+    /// `harmonics = [{ order = 5, fraction = 0.03 }]`: each follows the fundamental's
+    /// phase and frequency and scales with its voltage steps.
+    #[serde(default)]
+    pub harmonics: Vec<SupplyHarmonic>,
+}
+
+/// One voltage harmonic of the supply: `fraction` of the fundamental's amplitude at
+/// `order` times its frequency, in the sequence of its order (5, 11, 17, ...: negative,
+/// turning against the fundamental; 7, 13, 19, ...: positive), at `phase_deg` against
+/// the fundamental's phase times the order. The phase voltages of a balanced set: orders
+/// divisible by 3 are zero-sequence, which a three-wire motor draws no current from, and
+/// are refused.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SupplyHarmonic {
+    /// Harmonic order n (2..=49, not a multiple of 3).
+    pub order: u32,
+    /// Amplitude as a fraction of the fundamental's (0..=0.2; EN 50160 allows 6 % of the 5th).
+    pub fraction: f64,
+    /// Phase [deg] against the fundamental's phase times `order` (default 0).
+    #[serde(default)]
+    pub phase_deg: f64,
+}
+
+impl SupplyHarmonic {
+    /// Whether the harmonic turns with the fundamental (order 3k + 1) or against it (3k + 2).
+    pub fn positive_sequence(&self) -> bool {
+        self.order % 3 == 1
+    }
 }
 
 /// One supply step. Either or both of `v_scale` and `f_hz`.
@@ -327,6 +357,35 @@ impl SupplySpec {
             }
             if let Some(f) = st.f_hz {
                 positive("supply.steps.f_hz", f)?;
+            }
+        }
+        for h in &self.harmonics {
+            if !(2..=49).contains(&h.order) {
+                return invalid(
+                    "supply.harmonics.order",
+                    format!("{} is not a harmonic order from 2 to 49", h.order),
+                );
+            }
+            if h.order % 3 == 0 {
+                return invalid(
+                    "supply.harmonics.order",
+                    format!(
+                        "{} is a multiple of 3: a zero-sequence harmonic, which a three-wire motor draws no current from",
+                        h.order
+                    ),
+                );
+            }
+            if !(0.0..=0.2).contains(&h.fraction) {
+                return invalid(
+                    "supply.harmonics.fraction",
+                    format!("{} is outside 0..0.2 of the fundamental", h.fraction),
+                );
+            }
+            if !h.phase_deg.is_finite() {
+                return invalid(
+                    "supply.harmonics.phase_deg",
+                    "must be a finite number".into(),
+                );
             }
         }
         Ok(())

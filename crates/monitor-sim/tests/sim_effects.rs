@@ -176,6 +176,67 @@ fn sim_supply_unbalance_gives_the_stated_negative_sequence() {
     assert!((ang - 30.0).abs() < 0.1, "{ang}");
 }
 
+/// The supply's voltage harmonics: each at its order's multiple of the fundamental, turning
+/// with it (7: positive sequence) or against it (5: negative), at its stated fraction and
+/// phase (phase a: `k cos(n w t + phi)`); an order divisible by 3 (zero sequence) is refused
+/// with its key.
+#[test]
+fn sim_supply_harmonics_are_in_the_sequence_of_their_order() {
+    let p = ParamFile::reference_2p2kw();
+    let mut sc = Scenario::steady(0.2, 10_000.0);
+    sc.supply.harmonics = vec![
+        sim::SupplyHarmonic {
+            order: 5,
+            fraction: 0.03,
+            phase_deg: 20.0,
+        },
+        sim::SupplyHarmonic {
+            order: 7,
+            fraction: 0.02,
+            phase_deg: -40.0,
+        },
+    ];
+    let rows = sim::simulate_to_vec(&p, &sc).unwrap();
+    // alpha + j beta = sum over m of C_m e^{j m w t}: C_m by a DFT over whole cycles.
+    let w = 2.0 * std::f64::consts::PI * 50.0;
+    let coef = |m: f64| {
+        let (mut re, mut im) = (0.0, 0.0);
+        let n = 2000;
+        for r in &rows[..n] {
+            let v = r.v_abc.unwrap();
+            let a = (2.0 * v[0] - v[1] - v[2]) / 3.0;
+            let b = (v[1] - v[2]) / 3f64.sqrt();
+            let (s, c) = (m * w * r.t_s).sin_cos();
+            re += a * c + b * s;
+            im += b * c - a * s;
+        }
+        (re.hypot(im) / n as f64, im.atan2(re).to_degrees())
+    };
+    let (v1, _) = coef(1.0);
+    let (n5, a5) = coef(-5.0);
+    let (p7, a7) = coef(7.0);
+    let (p5, _) = coef(5.0);
+    let (n7, _) = coef(-7.0);
+    eprintln!("V1 {v1:.2}; 5th {n5:.3} at {a5:.2} deg (against), {p5:.4} (with); 7th {p7:.3} at {a7:.2} deg, {n7:.4}");
+    assert!((n5 / v1 - 0.03).abs() < 1e-4, "5th {}", n5 / v1);
+    assert!((p7 / v1 - 0.02).abs() < 1e-4, "7th {}", p7 / v1);
+    assert!(
+        p5 / v1 < 1e-5 && n7 / v1 < 1e-5,
+        "a harmonic in the other sequence"
+    );
+    // Phase a's k cos(n w t + phi): the 7th's vector k e^{j(7wt + phi)}, the 5th's
+    // k e^{-j(5wt + phi)}.
+    assert!((a7 + 40.0).abs() < 0.2, "7th at {a7} deg");
+    assert!((a5 + 20.0).abs() < 0.2, "5th at {a5} deg");
+
+    sc.supply.harmonics[0].order = 3;
+    let e = sim::simulate_to_vec(&p, &sc).unwrap_err().to_string();
+    assert!(
+        e.contains("supply.harmonics.order") && e.contains("zero-sequence"),
+        "{e}"
+    );
+}
+
 #[test]
 fn sim_phase_asymmetry_unbalances_the_currents_towards_the_faulty_phase() {
     let p = ParamFile::reference_3hp();

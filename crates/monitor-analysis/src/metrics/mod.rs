@@ -10,8 +10,11 @@ use super::prep::{phase_values, Prepared, C64};
 use super::simplified_model::Prediction;
 use serde::Serialize;
 
+mod noise;
 mod trace;
 mod worst;
+
+pub use noise::white_noise_sigma;
 
 pub use trace::{error_over_time, TRACE_POINTS};
 pub use worst::{error_kind, windows, Condition, WorstWindow};
@@ -218,25 +221,6 @@ pub fn diverged_at(d: &Prepared, p: &Prediction) -> Option<f64> {
         return Some(t(k));
     }
     (p.i_ab.len() < n).then(|| t(p.i_ab.len()))
-}
-
-/// Robust white-noise estimate of a series: sigma = 1.4826 MAD(D^4 x) / sqrt(70), the
-/// median absolute deviation of the fourth difference (70 = C(8,4), the variance gain of
-/// the fourth difference on white noise). A smooth signal and sparse steps do not move it;
-/// the fourth (not the second) difference also ignores a 2f ripple, which an unbalanced
-/// machine puts on I_qs (0.1 A of second difference per A of 100 Hz ripple at 2 kHz, as
-/// much as the sensor noise; 0.01 A with the fourth).
-pub fn white_noise_sigma(x: &[f64]) -> f64 {
-    if x.len() < 9 {
-        return 0.0;
-    }
-    let mut dd: Vec<f64> = x
-        .windows(5)
-        .map(|v| (v[4] - 4.0 * v[3] + 6.0 * v[2] - 4.0 * v[1] + v[0]).abs())
-        .collect();
-    let mid = dd.len() / 2;
-    let (_, m, _) = dd.select_nth_unstable_by(mid, |a, b| a.total_cmp(b));
-    1.4826 * *m / 70f64.sqrt()
 }
 
 /// Noise floor: the `normalized_rms_error` a perfect model would show on this log.
