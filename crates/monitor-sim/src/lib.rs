@@ -104,6 +104,7 @@ mod run;
 mod scenario;
 mod sensors;
 mod steady;
+mod supply;
 mod thermometer;
 
 pub use effect_spec::EffectSpec;
