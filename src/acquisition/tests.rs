@@ -96,7 +96,7 @@ fn a_clip_on_two_of_eight_conversions_is_caught_where_the_mean_is_not() {
 /// The check two conversions at a time is [`LinearRange::clips`] of each conversion: every
 /// code 0..=4095 at every one of a sample's 24 places, against channels of three different
 /// ranges (each place's channel its own), the other codes inside; the sums those of the
-/// codes.
+/// codes; with `sum_clipped` and with `sum_clipped_portable`.
 #[test]
 fn the_check_two_at_a_time_is_the_range_test_of_each_conversion() {
     let ranges = [
@@ -123,6 +123,13 @@ fn the_check_two_at_a_time_is_the_range_test_of_each_conversion() {
             let want = others_clip || ranges[channel].clips(code);
             assert_eq!(clipped, want, "place {place} code {code}");
             assert_eq!(sums, sum_half(&half).0, "place {place} code {code}");
+            // The Rust alone (what `cargo qemu-core` checks the board's kernel against).
+            let portable = sum_clipped_portable(&half, &limits);
+            assert_eq!(
+                portable,
+                (sum_half(&half).0, want),
+                "place {place} code {code}"
+            );
         }
     }
     // And with channel c inside a range of its own, only the code tested clips.
@@ -136,6 +143,12 @@ fn the_check_two_at_a_time_is_the_range_test_of_each_conversion() {
             assert_eq!(
                 sum_clipped(&half, &limits).1,
                 want,
+                "place {place} code {code}"
+            );
+            let portable = sum_clipped_portable(&half, &limits);
+            assert_eq!(
+                portable,
+                (sum_half(&half).0, want),
                 "place {place} code {code}"
             );
         }
@@ -170,6 +183,48 @@ fn the_check_two_at_a_time_is_the_range_test_of_each_conversion() {
     }
 }
 
+/// Clips at several places at once are flagged as one alone is: any two of a sample's 24
+/// conversions on a rail (of one word position, of one half of the words, of two), and
+/// all 24; and a channel whose range is inverted (`low` above `high`: every code clips, one
+/// between them beyond both limits at once), all its conversions there; with `sum_clipped`
+/// and `sum_clipped_portable`.
+#[test]
+fn clips_at_several_places_at_once_are_flagged() {
+    type Kernel = fn(&[u16; HALF_LEN], &ClipLimits) -> ([u32; CHANNELS], bool);
+    let kernels: [Kernel; 2] = [sum_clipped, sum_clipped_portable];
+    let rails = ClipLimits::new(&[LinearRange::RAILS; CHANNELS]);
+    for kernel in kernels {
+        for first in 0..HALF_LEN {
+            for second in first + 1..HALF_LEN {
+                for (x, y) in [(0, 0), (4095, 4095), (0, 4095), (4095, 0)] {
+                    let mut half = [2048u16; HALF_LEN];
+                    (half[first], half[second]) = (x, y);
+                    assert!(kernel(&half, &rails).1, "{first} {second}: {x} {y}");
+                }
+            }
+        }
+        for rail in [0, 4095] {
+            assert!(kernel(&[rail; HALF_LEN], &rails).1, "all at {rail}");
+        }
+        for channel in 0..CHANNELS {
+            let mut ranges = [LinearRange::RAILS; CHANNELS];
+            ranges[channel] = LinearRange {
+                low: 3000,
+                high: 1000,
+            };
+            let limits = ClipLimits::new(&ranges);
+            for code in [500u16, 1000, 2000, 3000, 3500] {
+                assert!(ranges[channel].clips(code), "{code}");
+                // Every conversion of the channel at `code`, the others inside their rails.
+                let half: [u16; HALF_LEN] =
+                    std::array::from_fn(|k| if k % CHANNELS == channel { code } else { 2048 });
+                let clipped = kernel(&half, &limits).1;
+                assert!(clipped, "channel {channel} code {code}");
+            }
+        }
+    }
+}
+
 /// A clip is held through the filter's memory: the clipped sample and the 16 after it.
 #[test]
 fn a_clip_is_held_for_the_filters_memory() {
@@ -178,6 +233,15 @@ fn a_clip_is_held_for_the_filters_memory() {
     assert_eq!(hold.step([false, true]), [false, true]);
     let flagged = (0..40).take_while(|_| hold.step([false, false])[1]).count();
     assert_eq!(flagged, usize::from(CLIP_HOLD_SAMPLES));
+    assert_eq!(hold.step([false, false]), [false, false]);
+    // The voltages' flag the same, on its own: a voltage clip, then one on both.
+    assert_eq!(hold.step([true, false]), [true, false]);
+    let flagged = (0..40).take_while(|_| hold.step([false, false])[0]).count();
+    assert_eq!(flagged, usize::from(CLIP_HOLD_SAMPLES));
+    assert_eq!(hold.step([true, true]), [true, true]);
+    for k in 0..CLIP_HOLD_SAMPLES {
+        assert_eq!(hold.step([false, false]), [true, true], "{k}");
+    }
     assert_eq!(hold.step([false, false]), [false, false]);
     // The filter's first stage keeps (3/4)^16 = 1.0 % of the clipped sample by then.
     assert!(0.75f64.powi(i32::from(CLIP_HOLD_SAMPLES)) < 0.011);
@@ -193,6 +257,10 @@ fn encoder_steps_beyond_the_maximum_speed_are_rejected_and_do_not_move_the_count
     assert_eq!(max_step_per_trigger(4_096, 50.0, 80_000), 4);
     assert_eq!(max_step_per_trigger(4_096, 0.0, 80_000), 1);
     assert_eq!(max_step_per_trigger(4_096, f32::NAN, 80_000), 1);
+    // Invalid inputs, 1 as for no motion: an endless speed, a negative one, no trigger.
+    assert_eq!(max_step_per_trigger(4_096, f32::INFINITY, 80_000), 1);
+    assert_eq!(max_step_per_trigger(4_096, -50.0, 80_000), 1);
+    assert_eq!(max_step_per_trigger(4_096, 50.0, 0), 1);
     let mut check = EncoderCheck::new(4);
     // 3 counts a trigger, wrapping the 16-bit counter: nothing rejected.
     let mut counts: Vec<u16> = (0..24u16).map(|k| 65_500u16.wrapping_add(3 * k)).collect();

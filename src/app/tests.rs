@@ -74,3 +74,70 @@ fn the_supervisor_shows_the_brown_out_mark_while_the_level_is_below_the_goal() {
     assert!(marked[40..50].iter().all(|on| !on));
     assert!(!plain[50..90].iter().all(|on| *on));
 }
+
+/// The log names each command, each its own name, and says why one was refused, each
+/// refusal its own: the sample path's refusals as the core gives them (a bad duration, a run
+/// already active, a cancel of a run not learning), a report of an older run, a calibration
+/// out of the core's range.
+#[test]
+fn each_command_is_named_and_each_refusal_says_why() {
+    let record = CalibrationRecord::from(monitor_core::Calibration::default());
+    let commands = [
+        (Command::StartCommissioning { duration_s: 10.0 }, "start"),
+        (Command::CancelCommissioning { run: 1 }, "cancel"),
+        (
+            Command::CalibrationStored {
+                run: 1,
+                stored: None,
+            },
+            "stored",
+        ),
+        (Command::SetCalibration(record), "set"),
+        (Command::PauseAcquisition, "pause"),
+        (Command::ReferenceGain(1.0), "reference"),
+    ];
+    for (k, (command, what)) in commands.iter().enumerate() {
+        assert!(command.name().contains(what), "{command:?}");
+        for (other, _) in &commands[k + 1..] {
+            assert_ne!(command.name(), other.name(), "{command:?} {other:?}");
+        }
+    }
+    let mut path = SamplePath::for_board(Settings::DEFAULT.sample_rate_hz).unwrap();
+    let start = |d| Command::StartCommissioning { duration_s: d };
+    let duration = path.command(start(-1.0)).unwrap_err();
+    path.command(start(10.0)).unwrap();
+    let busy = path.command(start(10.0)).unwrap_err();
+    let not_learning = path
+        .command(Command::CancelCommissioning { run: 99 })
+        .unwrap_err();
+    let bad = MonitorConfig {
+        sample_rate_hz: 0.0,
+        ..board_monitor_config(Settings::DEFAULT.sample_rate_hz)
+    };
+    let calibration = CommandError::Calibration(bad.validate().unwrap_err());
+    let stale = CommandError::Commissioning(monitor_core::CommissioningError::StaleRun);
+    let said = [
+        (duration, "duration"),
+        (busy, "active"),
+        (stale, "older run"),
+        (not_learning, "not learning"),
+        (calibration, "range"),
+    ];
+    for (k, (error, why)) in said.iter().enumerate() {
+        let text = error.describe();
+        assert!(text.contains(why), "{error:?}: {text}");
+        for (other, _) in &said[k + 1..] {
+            assert_ne!(text, other.describe(), "{error:?} {other:?}");
+        }
+    }
+}
+
+/// Before any sample no fault is probable: the status names no candidate, top or second
+/// (a fault of probability 0 is none).
+#[test]
+fn before_any_sample_the_status_names_no_candidate() {
+    let status = SamplePath::for_board(Settings::DEFAULT.sample_rate_hz)
+        .unwrap()
+        .status();
+    assert_eq!((status.top, status.second), (None, None));
+}

@@ -86,3 +86,32 @@ pub fn read_blink_code(trace: &[bool], step_ms: u32) -> Option<u8> {
     }
     None
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A code of `n` is `n` pulses of 250 ms, each at the start of its 500 ms slot, then
+    /// 1.5 s dark, over and over: lit 250 ms of each slot and `n x 250` ms a period, at
+    /// the millisecond; code 0 never lit.
+    #[test]
+    fn a_codes_pulses_are_250_ms_at_the_start_of_each_500_ms_slot() {
+        for n in [1u8, 2, 9, NOT_NAMED_CODE, winding_code(2)] {
+            let period = u32::from(n) * 500 + 1_500;
+            let lit = (0..period).filter(|t| blink_code_lamp(n, *t)).count();
+            assert_eq!(lit, usize::from(n) * 250, "code {n}");
+            for start in (0..u32::from(n)).map(|k| k * 500) {
+                for t in [start, start + 249, period + start] {
+                    assert!(blink_code_lamp(n, t), "code {n} at {t} ms");
+                }
+                for t in [start + 250, start + 499] {
+                    assert!(!blink_code_lamp(n, t), "code {n} at {t} ms");
+                }
+            }
+            for t in u32::from(n) * 500..period {
+                assert!(!blink_code_lamp(n, t), "code {n} at {t} ms: the gap");
+            }
+        }
+        assert!((0..10_000).all(|t| !blink_code_lamp(0, t)));
+    }
+}

@@ -118,3 +118,63 @@ fn an_encoder_glitch_is_rejected_counted_and_not_taken_as_speed() {
         "{top} against {clean_top} rad/s"
     );
 }
+
+/// A sample's latched counts, `step` counts a trigger on from `count`.
+fn moving(count: &mut u16, step: u16) -> [u16; OVERSAMPLING] {
+    std::array::from_fn(|_| {
+        *count = count.wrapping_add(step);
+        *count
+    })
+}
+
+/// After a gap in the triggers (a recovery, a paused acquisition) the shaft may have moved
+/// any distance: with the builder restarted the first count after it is no glitch (without,
+/// one reject). A dropped sample's counts still go through the check: the next sample's
+/// first step is one trigger long, not nine, and no glitch either (without, one reject).
+#[test]
+fn a_gap_restarts_the_encoder_check_and_a_dropped_samples_counts_go_through_it() {
+    let rec = motor_source::default_record();
+    let max = motor_source::encoder_setup(&rec, FS).max_step_per_trigger;
+    let step = (max / 2).max(1);
+    assert!(
+        9 * step > max,
+        "nine triggers' motion is beyond one trigger's largest step"
+    );
+    let mid = [2048u16; HALF_LEN];
+    for handled in [true, false] {
+        let new = || FrameBuilder::new(FS, 50.0, motor_source::linear_ranges(&rec), max);
+        let want = u8::from(!handled);
+        // The gap: 5 000 counts on.
+        let (mut builder, mut count) = (new(), 0u16);
+        for _ in 0..4 {
+            assert_eq!(
+                builder
+                    .frame(&mid, &mid, &moving(&mut count, step))
+                    .encoder_rejects,
+                0
+            );
+        }
+        count = count.wrapping_add(5_000);
+        if handled {
+            builder.restart();
+        }
+        let after = builder.frame(&mid, &mid, &moving(&mut count, step));
+        assert_eq!(after.encoder_rejects, want, "restarted {handled}");
+        // A dropped sample.
+        let (mut builder, mut count) = (new(), 0u16);
+        for _ in 0..4 {
+            assert_eq!(
+                builder
+                    .frame(&mid, &mid, &moving(&mut count, step))
+                    .encoder_rejects,
+                0
+            );
+        }
+        let dropped = moving(&mut count, step);
+        if handled {
+            builder.skip(&dropped);
+        }
+        let after = builder.frame(&mid, &mid, &moving(&mut count, step));
+        assert_eq!(after.encoder_rejects, want, "skipped {handled}");
+    }
+}

@@ -125,3 +125,50 @@ fn the_zero_is_re_trimmed_whenever_the_shaft_stands_and_the_currents_are_zero() 
     let scale = path.sampler().front_end().current[0];
     assert!(scale.apply(2084).abs() < 1e-3);
 }
+
+/// With the reference's correction in force (VDDA 3.21 V now against 3.30 V at
+/// commissioning), the start-up trim puts the zero read now into force, for either bias:
+/// the front end keeps it at commissioning's reference (an absolute zero's code times the
+/// gain, one at VDDA / 2 as it is), and the correction brings it back to the code read now,
+/// which then reads 0 A.
+#[test]
+fn a_trim_under_the_reference_correction_puts_the_zero_read_now_in_force() {
+    let gain = NOW / AT_COMMISSIONING;
+    for bias in [ZeroBias::HalfVdda, ZeroBias::Absolute] {
+        let mut path = SamplePath::for_board(FS).unwrap();
+        path.set_zero_bias(bias);
+        path.set_reference_gain(gain);
+        let mut kinds = Vec::new();
+        for _ in 0..TRIM_SAMPLES {
+            kinds.extend(path.trim_offsets(&still(2100, 0)).map(|t| t.kind));
+            path.on_frame(&still(2100, 0));
+        }
+        assert_eq!(kinds, [TrimKind::StartUp], "{bias:?}");
+        for scale in path.sampler().front_end().current {
+            let zero = scale.offset_code;
+            assert!((zero - 2100.0).abs() < 0.01, "{bias:?}: {zero}");
+            assert!(scale.apply(2100).abs() < 1e-3, "{bias:?}: {zero}");
+        }
+    }
+}
+
+/// A re-trim is reported (for the log) only when it moved a zero by half a code or more: a
+/// standstill at the zero in force is not, one at a code beside it is.
+#[test]
+fn a_re_trim_is_reported_only_when_it_moved_a_zero() {
+    let mut path = SamplePath::for_board(FS).unwrap();
+    // Running (`running` samples, the count moving), then a standstill at `zero`: the trims
+    // reported.
+    let mut window = |running: u16, zero: u16| {
+        let mut kinds = Vec::new();
+        let frames = (0..running).map(|k| still(zero, k * 13));
+        for frame in frames.chain((0..TRIM_SAMPLES).map(|_| still(zero, 7_000))) {
+            kinds.extend(path.trim_offsets(&frame).map(|t| t.kind));
+            path.on_frame(&frame);
+        }
+        kinds
+    };
+    assert_eq!(window(0, 2048), [TrimKind::StartUp]);
+    assert_eq!(window(500, 2048), []);
+    assert_eq!(window(500, 2049), [TrimKind::Retrim]);
+}

@@ -8,7 +8,8 @@ use super::*;
 /// full scale, which is a sensor fault, the steady lamp, tested below); the FAULT lamp the
 /// supervisor drives blinks the isolated fault's code (Bl: the friction class is named but,
 /// as a load change beyond the commissioned range, shown as "operating point moved"), and the
-/// isolation's size is within 20 % of the truth (relative), both as thread mode has them.
+/// isolation's size is within 20 % of the truth (relative), both as thread mode has them;
+/// the status's top and second candidates are the two most probable faults.
 #[test]
 fn the_fault_lamp_blinks_the_isolated_fault_and_the_size_is_right() {
     let cases = [
@@ -20,7 +21,7 @@ fn the_fault_lamp_blinks_the_isolated_fault_and_the_size_is_right() {
         (Fault::VoltageSensor, true, 0.2),
         (Fault::SpeedSensor, true, 0.5),
     ];
-    let mut wrong = Vec::new();
+    let (mut wrong, mut seconds) = (Vec::new(), 0);
     for (fault, sensor, change) in cases {
         // Long enough for two periods of blink code 9 after the fault is named (about 2 s
         // after it: the first deviation restarts the average, monitor_core's follower).
@@ -56,6 +57,18 @@ fn the_fault_lamp_blinks_the_isolated_fault_and_the_size_is_right() {
             Some(fault.index() as u8 + 1)
         };
         let moved_ok = fault != Fault::Bl || rig.last().status.moved;
+        // The status's candidates: the most probable fault, and the most probable after it
+        // (the first of equals, as the top's), of those with a probability.
+        let output = rig.path.monitor().output();
+        let mut ranked: Vec<(Fault, f32)> = (Fault::ALL.into_iter())
+            .zip(output.diagnosis.probabilities)
+            .filter(|(_, p)| *p > 0.0)
+            .collect();
+        ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let status = rig.path.status();
+        assert_eq!(status.top, ranked.first().copied(), "{fault:?}");
+        assert_eq!(status.second, ranked.get(1).copied(), "{fault:?}");
+        seconds += usize::from(status.second.is_some());
         let iso = rig.supervisor.isolation().copied();
         let size = iso.and_then(|i| i.named()).map(|n| match n {
             monitor_core::Named::Fault(c) => (c.fault, c.change),
@@ -75,6 +88,7 @@ fn the_fault_lamp_blinks_the_isolated_fault_and_the_size_is_right() {
         }
     }
     assert!(wrong.is_empty(), "{wrong:#?}");
+    assert!(seconds > 0, "no second candidate");
 }
 
 /// The isolation baseline learned in a commissioning run is stored with its calibration

@@ -95,3 +95,18 @@ fn a_commissioning_run_stores_the_reference_it_learned_at() {
     assert!((v - 3.287).abs() < 0.005, "{v}");
     assert_eq!(rig.paused_for_flash, 1, "the store paused the acquisition");
 }
+
+/// A gain beyond the reference's band (0.9..=1.1: a VDDA 10 % off, whose readings are
+/// flagged anyway), or not finite, is ignored: the correction in force stays.
+#[test]
+fn a_gain_beyond_the_band_is_ignored() {
+    let mut path = SamplePath::for_board(FS).unwrap();
+    for gain in [0.9, 1.1, 0.97] {
+        path.set_reference_gain(gain);
+        assert_eq!(path.reference_gain(), gain);
+    }
+    for gain in [0.89, 1.11, 0.5, 2.0, f32::NAN, f32::INFINITY, -1.0] {
+        path.set_reference_gain(gain);
+        assert_eq!(path.reference_gain(), 0.97, "{gain}");
+    }
+}

@@ -117,6 +117,9 @@ fn the_internal_oscillators_tolerance_scales_the_frequency_and_speed_estimates()
         );
     }
     let (_, f0, w0, ..) = seen[1];
+    // On time, the frame's frequency is the supply's, in Hz (the core's is in rad/s).
+    let supply_hz = ParamFile::reference_2p2kw().supply.f_hz;
+    assert!((f64::from(f0) / supply_hz - 1.0).abs() < 2e-3, "{f0} Hz");
     for &(error, f_hz, w_rad_s, fault, _) in &seen {
         let scale = 1.0 / (1.0 + error);
         assert!(
