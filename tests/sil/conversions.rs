@@ -144,16 +144,21 @@ fn a_gap_restarts_the_encoder_check_and_a_dropped_samples_counts_go_through_it()
     for handled in [true, false] {
         let new = || FrameBuilder::new(FS, 50.0, motor_source::linear_ranges(&rec), max);
         let want = u8::from(!handled);
+        // Four frames of steady motion, none rejected: the builder and the count after them.
+        let settled = || {
+            let (mut builder, mut count) = (new(), 0u16);
+            for _ in 0..4 {
+                assert_eq!(
+                    builder
+                        .frame(&mid, &mid, &moving(&mut count, step))
+                        .encoder_rejects,
+                    0
+                );
+            }
+            (builder, count)
+        };
         // The gap: 5 000 counts on.
-        let (mut builder, mut count) = (new(), 0u16);
-        for _ in 0..4 {
-            assert_eq!(
-                builder
-                    .frame(&mid, &mid, &moving(&mut count, step))
-                    .encoder_rejects,
-                0
-            );
-        }
+        let (mut builder, mut count) = settled();
         count = count.wrapping_add(5_000);
         if handled {
             builder.restart();
@@ -161,15 +166,7 @@ fn a_gap_restarts_the_encoder_check_and_a_dropped_samples_counts_go_through_it()
         let after = builder.frame(&mid, &mid, &moving(&mut count, step));
         assert_eq!(after.encoder_rejects, want, "restarted {handled}");
         // A dropped sample.
-        let (mut builder, mut count) = (new(), 0u16);
-        for _ in 0..4 {
-            assert_eq!(
-                builder
-                    .frame(&mid, &mid, &moving(&mut count, step))
-                    .encoder_rejects,
-                0
-            );
-        }
+        let (mut builder, mut count) = settled();
         let dropped = moving(&mut count, step);
         if handled {
             builder.skip(&dropped);
