@@ -426,15 +426,15 @@ impl Analysis {
         active: &[ActiveEffect<'_>],
         f: &FitResult,
     ) -> Result<Vec<FittedEffect>, effects::EffectValuesError> {
-        if active.len() != f.effect_params.len() {
+        if active.len() != f.reported().len() {
             return Err(effects::EffectValuesError::Effects {
                 expected: active.len(),
-                got: f.effect_params.len(),
+                got: f.reported().len(),
             });
         }
         active
             .iter()
-            .zip(&f.effect_params)
+            .zip(f.reported())
             .map(|(a, p)| {
                 let mut why = a.setup.implausible(p);
                 why.extend(a.setup.pinned(p));
@@ -479,12 +479,7 @@ impl Analysis {
         f: &FitResult,
     ) -> Result<Prediction, effects::EffectValuesError> {
         let mut terms = fit::terms(d, &self.constants, active, f)?;
-        let sigma_v = 0.5 * (metrics::white_noise_sigma(&d.vd) + metrics::white_noise_sigma(&d.vq));
-        terms.input_noise = Some(simplified_model::InputNoise {
-            seed: 0x006e_6f69_7365,
-            sigma_v,
-            sigma_i: metrics::white_noise_sigma(&d.id),
-        });
+        terms.input_noise = Some(metrics::input_noise(d, 0x006e_6f69_7365));
         Ok(simplified_model::simulate(
             d,
             &self.constants,
@@ -528,9 +523,11 @@ pub(crate) fn parameter_table(
 /// count (data-dependent set-ups such as load steps may differ between the coarse and the
 /// full series; then the set-up's initial values stand).
 pub(crate) fn align(active: &[ActiveEffect<'_>], mut f: FitResult) -> FitResult {
-    for (a, p) in active.iter().zip(f.effect_params.iter_mut()) {
-        if p.len() != a.setup.len() {
-            *p = a.setup.init();
+    for values in std::iter::once(&mut f.effect_params).chain(f.corrected.as_mut()) {
+        for (a, p) in active.iter().zip(values.iter_mut()) {
+            if p.len() != a.setup.len() {
+                *p = a.setup.init();
+            }
         }
     }
     f

@@ -16,12 +16,13 @@ use super::lm::{self, LeastSquares};
 use super::metrics::{measured, predicted, Weights};
 use super::prep::Prepared;
 use super::simplified_model::{
-    rotations, simulate, simulate_rot, BaseParams, MachineConstants, ModelTerms, Prediction,
-    Rotations,
+    rotations, simulate, simulate_rot, BaseParams, InputNoise, MachineConstants, ModelTerms,
+    Prediction, Rotations,
 };
 
 mod identifiability;
 pub mod machine;
+pub mod simex;
 
 use identifiability::Gram;
 pub use identifiability::{jacobian, Jacobian, ParameterSensitivity, IDENTIFIED_MIN};
@@ -43,6 +44,20 @@ pub struct FitResult {
     pub effect_params: Vec<Vec<f64>>,
     /// How the solver ended (iterations, final cost, reason).
     pub report: lm::Report,
+    /// The effects' values corrected for the inputs' sensor noise by SIMEX ([`simex`]),
+    /// where an effect of the fit is biased by it
+    /// ([`EffectModel::biased_by_input_noise`]); `None` otherwise. What is reported and
+    /// judged plausible ([`FitResult::reported`]); `effect_params` stay what the model
+    /// predicts with, so that errors compare like with like.
+    pub corrected: Option<Vec<Vec<f64>>>,
+}
+
+impl FitResult {
+    /// The effects' values to report and judge: the SIMEX-corrected ones where there are
+    /// ([`FitResult::corrected`]), else the fitted ones.
+    pub fn reported(&self) -> &[Vec<f64>] {
+        self.corrected.as_deref().unwrap_or(&self.effect_params)
+    }
 }
 
 /// Weight of the base parameters' priors relative to the data (whose residuals are scaled
@@ -130,6 +145,9 @@ struct Problem<'a> {
     targets: Vec<(usize, [f64; 5])>,
     /// 1/sqrt(number of targets).
     norm: f64,
+    /// Extra white noise on the model's inputs in every simulation of the fit (`None`: the
+    /// measured inputs as they are); SIMEX's refits (`simex.rs`).
+    extra_noise: Option<InputNoise>,
 }
 
 impl<'a> Problem<'a> {
@@ -162,6 +180,7 @@ impl<'a> Problem<'a> {
             rot: rotations(d),
             norm: 1.0 / (targets.len().max(1) as f64).sqrt(),
             targets,
+            extra_noise: None,
         }
     }
 
@@ -172,6 +191,7 @@ impl<'a> Problem<'a> {
         for (e, p) in effect_values(self.effects, x.get(N_BASE..).unwrap_or(&[]))? {
             e.setup.contribute(p, self.d, self.n, &mut terms)?;
         }
+        terms.input_noise = self.extra_noise;
         Ok(terms)
     }
 
@@ -356,20 +376,7 @@ pub fn fit_spec(
 ) -> Result<FitResult, EffectValuesError> {
     let prob = Problem::new(d, n, effects, w, spec);
     let (x, bounds) = start_and_bounds(start, effects, prob.btot_scale);
-    let held: usize = effects
-        .iter()
-        .take(spec.hold_first)
-        .map(|e| e.setup.len())
-        .sum();
-    let free: Vec<usize> = (0..x.len())
-        .filter(|&i| {
-            if i < N_BASE {
-                spec.free[i]
-            } else {
-                i >= N_BASE + held
-            }
-        })
-        .collect();
+    let free = free_values(effects, spec, x.len());
     prob.terms(&x)?;
     // From `x`, then from each effect's other starts (`FitSetup::alt_init`, one effect's
     // at a time): the lowest final cost wins.
@@ -388,14 +395,53 @@ pub fn fit_spec(
         o += k;
     }
     let (x, report) = best;
+    let renoised = |nz| Problem {
+        extra_noise: Some(nz),
+        ..Problem::new(d, n, effects, w, spec)
+    };
+    let mut f = result_at(effects, &x, report)?;
+    if effects.iter().any(|e| e.effect.biased_by_input_noise()) {
+        if let Some(c) = simex::corrected(d, renoised, &x, &bounds, &free, max_iter) {
+            f.corrected = Some(result_at(effects, &c, report)?.effect_params);
+        }
+    }
+    Ok(f)
+}
+
+/// The fit's result at the values `x` (base, then each effect's).
+fn result_at(
+    effects: &[ActiveEffect<'_>],
+    x: &[f64],
+    report: lm::Report,
+) -> Result<FitResult, EffectValuesError> {
     Ok(FitResult {
-        base: Problem::base(&x),
+        base: Problem::base(x),
         effect_params: effect_values(effects, x.get(N_BASE..).unwrap_or(&[]))?
             .into_iter()
             .map(|(_, p)| p.to_vec())
             .collect(),
         report,
+        corrected: None,
     })
+}
+
+/// The indices of the values a fit of `n` values moves: the base parameters `spec` frees,
+/// and every effect's value but those of the first `spec.hold_first` effects.
+fn free_values(effects: &[ActiveEffect<'_>], spec: BaseSpec, n: usize) -> Vec<usize> {
+    let held: usize = effects
+        .iter()
+        .take(spec.hold_first)
+        .map(|e| e.setup.len())
+        .sum();
+    (0..n)
+        .filter(|&i| {
+            if i < N_BASE {
+                spec.free[i]
+            } else {
+                i >= N_BASE + held
+            }
+        })
+        .collect()
 }
 
 /// The fit's start (the base parameters `start`, then each effect's initial values) and

@@ -244,6 +244,13 @@ pub trait EffectModel: Send + Sync {
     fn takes_viscous_part(&self) -> bool {
         false
     }
+    /// True for an effect whose fitted size the inputs' sensor noise biases (errors in
+    /// variables: a resistance's rise passes less of the voltages' noise to the currents,
+    /// so an output-error fit buys a lower error with a rise that is too large): a fit with
+    /// it is corrected by SIMEX (`crate::fit`'s `simex.rs`). Default: false.
+    fn biased_by_input_noise(&self) -> bool {
+        false
+    }
     /// The shaft torque [N m] of a load law of speed alone at the mechanical speed `w`
     /// [rad/s] with the values `values` (in the set-up's order): windage, dry friction, a
     /// load torque of one level, a user's load law of `w` alone. `None` (the default) for

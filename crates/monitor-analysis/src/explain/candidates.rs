@@ -256,7 +256,7 @@ impl Analysis {
     ) -> Result<Vec<String>, AnalysisError> {
         let d = &self.data;
         let mut why = me.implausible_because.clone();
-        let fitted = f.effect_params.last().map_or(&[][..], Vec::as_slice);
+        let fitted = f.reported().last().map_or(&[][..], Vec::as_slice);
         why.extend(c.contradicted_by(d, &self.constants, fitted)?);
         why.extend(base_newly_out_of_range(
             &self.constants,

@@ -94,7 +94,7 @@ pub(super) fn rank(
         return;
     }
     let says = |r: &RankedCandidate| {
-        let fitted = r.fit.effect_params.last().map(Vec::as_slice).unwrap_or(&[]);
+        let fitted = r.fit.reported().last().map(Vec::as_slice).unwrap_or(&[]);
         effects::model_of(r.candidate.effect).and_then(|m| {
             m.evidence(&EffectEvidence {
                 voltage_unbalance: unbalance.voltage_negative_sequence_ratio,

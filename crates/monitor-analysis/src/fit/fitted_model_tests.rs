@@ -28,6 +28,7 @@ fn a_fitted_model_says_what_it_is() {
                 cost: 1.5e-5,
                 termination: lm::Termination::Converged,
             },
+            corrected: None,
         },
     };
     let s = m.to_string();

@@ -240,6 +240,9 @@ pub struct MachineFit {
     pub effect_params: Vec<Vec<f64>>,
     /// How the solver ended.
     pub report: lm::Report,
+    /// The effects' values corrected for the inputs' noise (as
+    /// [`super::FitResult::corrected`]); `None` where no effect is biased by it.
+    pub corrected: Option<Vec<Vec<f64>>>,
 }
 
 impl MachineFit {
@@ -269,6 +272,8 @@ struct MachineProblem<'a> {
     /// torque at synchronous speed (a user's file does not know the load as a viscous
     /// coefficient, `bl_nms = 0`: the load is the usual unknown).
     b_sd_load: f64,
+    /// Extra input noise in every simulation (`None`: the log's inputs; SIMEX's refits).
+    extra_noise: Option<crate::simplified_model::InputNoise>,
 }
 
 impl MachineProblem<'_> {
@@ -289,6 +294,7 @@ impl MachineProblem<'_> {
                 _ => e.setup.contribute(p, self.d, &n, &mut terms)?,
             }
         }
+        terms.input_noise = self.extra_noise;
         Ok((n, terms))
     }
 
@@ -418,10 +424,19 @@ pub fn fit_machine_pinned(
     free.retain(|&i| pin.is_none_or(|k| i != k.index()));
     let bounds = lm::Bounds { lo, hi, scale };
     let (x, report) = lm::solve(&prob, x, &bounds, &free, max_iter);
+    let renoised = |nz| MachineProblem {
+        extra_noise: Some(nz),
+        ..problem(d, file, effects, w, prior_weight)
+    };
+    let corrected = match effects.iter().any(|e| e.effect.biased_by_input_noise()) {
+        true => super::simex::corrected(d, renoised, &x, &bounds, &free, max_iter),
+        false => None,
+    };
     Ok(MachineFit {
         scales: MachineScales::from_slice(&x),
         effect_params: prob.effect_values(&x),
         report,
+        corrected: corrected.map(|c| prob.effect_values(&c)),
     })
 }
 
@@ -447,6 +462,7 @@ fn problem<'a>(
         b_sd: PRIOR_SD[5] * super::btot_scale(&n, d),
         b_prior: !effects.iter().any(|e| e.effect.takes_viscous_part()),
         b_sd_load: n.torque_scale_nm / crate::effects::sync_speed_mech(d, &n),
+        extra_noise: None,
     }
 }
 
@@ -534,52 +550,4 @@ fn inflation(r: &[f64], nc: usize) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn applying_factors_keeps_the_circuit_consistent() {
-        let p = ParamFile::reference_2p2kw();
-        let s = MachineScales {
-            rs: 1.2,
-            rr: 0.9,
-            leakage: 1.5,
-            lm: 0.8,
-            j: 2.0,
-            b_nms: 0.03,
-        };
-        let q = s.apply(&p);
-        let (lls, llr) = (p.motor.ls_h - p.motor.lm_h, p.motor.lr_h - p.motor.lm_h);
-        assert!((q.motor.rs_ohm - 1.2 * p.motor.rs_ohm).abs() < 1e-12);
-        assert!((q.motor.rr_ohm - 0.9 * p.motor.rr_ohm).abs() < 1e-12);
-        assert!((q.motor.lm_h - 0.8 * p.motor.lm_h).abs() < 1e-12);
-        assert!((q.motor.ls_h - q.motor.lm_h - 1.5 * lls).abs() < 1e-12);
-        assert!((q.motor.lr_h - q.motor.lm_h - 1.5 * llr).abs() < 1e-12);
-        assert!((q.motor.j_kgm2 - 2.0 * p.motor.j_kgm2).abs() < 1e-12);
-        assert!((q.motor.b_nms + q.motor.bl_nms - 0.03).abs() < 1e-12);
-        // The file's own values give the file back.
-        assert_eq!(MachineScales::of_file(&p).apply(&p), p);
-        assert!((s.change(BaseKey::Rs, &p) - 0.2).abs() < 1e-12);
-    }
-
-    #[test]
-    fn correlated_residuals_inflate_the_variance() {
-        // White: about 1. A slow sine sampled finely: large.
-        // A 64-bit linear congruential generator's top bits (Knuth's MMIX constants).
-        let mut x: u64 = 1;
-        let white: Vec<f64> = (0..4000)
-            .map(|_| {
-                x = x
-                    .wrapping_mul(6_364_136_223_846_793_005)
-                    .wrapping_add(1_442_695_040_888_963_407);
-                (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-            })
-            .collect();
-        assert!(inflation(&white, 1) < 1.2, "{}", inflation(&white, 1));
-        let slow: Vec<f64> = (0..4000).map(|k| (k as f64 * 0.01).sin()).collect();
-        assert!(inflation(&slow, 1) > 100.0, "{}", inflation(&slow, 1));
-        // Interleaved channels are taken apart.
-        let two: Vec<f64> = slow.iter().flat_map(|v| [*v, -*v]).collect();
-        assert!((inflation(&two, 2) - inflation(&slow, 1)).abs() < 1e-9);
-    }
-}
+mod tests;

@@ -223,6 +223,18 @@ pub fn diverged_at(d: &Prepared, p: &Prediction) -> Option<f64> {
     (p.i_ab.len() < n).then(|| t(p.i_ab.len()))
 }
 
+/// The sensor noise of the model's inputs on `d`, as white noise of that level with the
+/// generator's `seed`: V_ds and V_qs share the mean of their two [`white_noise_sigma`]
+/// [V], I_ds takes its own [A] (0 for a series that is absent). Read by the noise floor's
+/// renoised run ([`noise_floor`]) and by SIMEX's refits (`crate::fit`).
+pub fn input_noise(d: &Prepared, seed: u64) -> crate::simplified_model::InputNoise {
+    crate::simplified_model::InputNoise {
+        seed,
+        sigma_v: 0.5 * (white_noise_sigma(&d.vd) + white_noise_sigma(&d.vq)),
+        sigma_i: white_noise_sigma(&d.id),
+    }
+}
+
 /// Noise floor: the `normalized_rms_error` a perfect model would show on this log.
 ///
 /// Two parts, added in quadrature per channel:

@@ -240,6 +240,7 @@ impl<'a> Ladder<'a> {
             scales,
             effect_params: c.fit.effect_params.clone(),
             report: c.fit.report,
+            corrected: c.fit.corrected.clone(),
         };
         let half = machine::machine_half_widths(&sr.fd, &sr.file, &set, &sr.wf, &mf)?;
         Ok(base_changes(&scales, &sr.file, &half))
@@ -259,6 +260,7 @@ fn base_prediction(
         base: BaseParams::nominal(&on.constants),
         effect_params: mf.effect_params.clone(),
         report: mf.report,
+        corrected: mf.corrected.clone(),
     };
     let pred = crate::fit::predict(&sr.fd, &on.constants, &set, &fit)?;
     let hb = metrics::errors(&sr.fd, &pred, Some(&sr.held_fd)).normalized_rms_error;

@@ -108,6 +108,7 @@ impl Ladder<'_> {
                 base: BaseParams::nominal(&fin.constants),
                 effect_params: mf.effect_params.clone(),
                 report: mf.report,
+                corrected: mf.corrected.clone(),
             },
         );
         let (pred, renoised) = fin.predict_and_renoised(&file.data, &active, &fit)?;
@@ -281,6 +282,7 @@ impl Ladder<'_> {
             scales: rung.scales,
             effect_params: f.effect_params,
             report: f.report,
+            corrected: f.corrected,
         };
         Ok((mf, [None; 6]))
     }

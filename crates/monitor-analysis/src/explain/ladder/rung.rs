@@ -228,7 +228,7 @@ pub(super) fn implausible_step(
     let d = &an.data;
     let mut why = Vec::new();
     for (i, a) in set.iter().enumerate().skip(rung.models.len()) {
-        let p = f.effect_params.get(i).map_or(&[][..], Vec::as_slice);
+        let p = f.reported().get(i).map_or(&[][..], Vec::as_slice);
         // The plausible ranges are those of the working series' set-up (a long log's
         // coarse copy may have fewer load segments: its own set-up then).
         let s_full = (m > 1)

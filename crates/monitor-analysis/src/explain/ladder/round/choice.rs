@@ -173,7 +173,7 @@ fn evidence_decides<'a>(an: &Analysis, fitted: &mut [Fitted<'a>], before: usize)
     }
     let unbalance = an.unbalance();
     let says = |c: &Fitted<'a>, e: &dyn EffectModel| {
-        let fitted = c.fit.effect_params.last().map(Vec::as_slice).unwrap_or(&[]);
+        let fitted = c.fit.reported().last().map(Vec::as_slice).unwrap_or(&[]);
         e.evidence(&effects::EffectEvidence {
             voltage_unbalance: unbalance.voltage_negative_sequence_ratio,
             winding_suspected: unbalance.suspect_phase.is_some(),
@@ -202,7 +202,7 @@ fn step_of(
     let mut fitted = BTreeMap::new();
     let mut described = Vec::new();
     for (i, e) in c.models.iter().enumerate().skip(before) {
-        let p = c.fit.effect_params.get(i).map_or(&[][..], Vec::as_slice);
+        let p = c.fit.reported().get(i).map_or(&[][..], Vec::as_slice);
         let Ok(setup) = e.setup(d, on.setup_constants()) else {
             continue;
         };
