@@ -395,12 +395,12 @@ impl FrameBuilder {
 }
 
 /// A candidate of the status: a fault and its probability, or none.
-type Candidate = Option<(Fault, f32)>;
+type StatusCandidate = Option<(Fault, f32)>;
 
 /// The status's two candidates from the core's output: the most probable fault
 /// ([`MonitorOutput::top`]) and the most probable after it, the first of equals as the
 /// top's; each only with a probability above zero.
-pub(super) fn candidates(o: &MonitorOutput) -> (Candidate, Candidate) {
+pub(super) fn candidates(o: &MonitorOutput) -> (StatusCandidate, StatusCandidate) {
     let top = o.top();
     let second = o
         .diagnosis
