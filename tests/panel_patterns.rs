@@ -31,13 +31,16 @@ fn first_wrong(input: &PanelInput, lit: impl Fn(u32) -> bool) -> Option<(u32, bo
         .find(|&(t, run)| run != lit(t))
 }
 
+/// A pattern: whether the lamp is lit at a time in milliseconds.
+type Pattern = fn(u32) -> bool;
+
 /// The module docs' table: commissioned, a 1 Hz blink (500 ms on / 500 ms off);
 /// commissioning, 5 Hz (100 on / 100 off); not commissioned, the double flash (100 on, 100
 /// off, 100 on, 1 700 off); the "operating point moved" triple flash (100 on, 100 off, 100
 /// on, 100 off, 100 on, 1 500 off); sampling stalled, 2 Hz (250 on / 250 off); failed, off.
 #[test]
 fn the_run_lamps_patterns_are_the_documented_ones_at_the_millisecond() {
-    let cases: [(PanelInput, fn(u32) -> bool, &str); 6] = [
+    let cases: [(PanelInput, Pattern, &str); 6] = [
         (input(Mode::Commissioned), |t| t % 1_000 < 500, "1 Hz"),
         (input(Mode::Commissioning), |t| t % 200 < 100, "5 Hz"),
         (
