@@ -60,8 +60,9 @@ pub use crate::adc_rules::CHANNELS;
 // (the firmware's library, the QEMU program).
 #[path = "acquisition/checks.rs"]
 mod checks;
-// The sample path's two kernels in Thumb-2 assembly (the per-conversion clip check with the
-// oversampled sums, the filter's stages): on the Cortex-M4 only; the host runs their Rust.
+// The sample path's three kernels in Thumb-2 assembly (the per-conversion clip check with the
+// oversampled sums, the filter's stages, the encoder check's steps): on the Cortex-M4 only;
+// the host runs their Rust.
 #[cfg(target_arch = "arm")]
 #[path = "acquisition/thumb.rs"]
 mod thumb;
@@ -75,8 +76,8 @@ mod filter;
 // The QEMU program uses a part of them.
 #[allow(unused_imports)]
 pub use checks::{
-    max_step_per_trigger, sum_clipped, sum_clipped_portable, ClipHold, EncoderCheck,
-    CLIP_HOLD_SAMPLES, FAST_MAX_STEP,
+    max_step_per_trigger, steps_ored, steps_ored_portable, sum_clipped, sum_clipped_portable,
+    ClipHold, EncoderCheck, CLIP_HOLD_SAMPLES, FAST_MAX_STEP,
 };
 #[allow(unused_imports)]
 pub use filter::{PwmFilter, ENCODER_DELAY_SAMPLES};

@@ -168,6 +168,59 @@ const fn window_bits(max_step: u16) -> u32 {
     b
 }
 
+/// Bit 15 of both halves of a word: what keeps [`sub_halves`] and [`add_halves`] from
+/// borrowing or carrying from one half into the other.
+const HALF_TOPS: u32 = 0x8000_8000;
+
+/// `a - b` half by half, each half modulo 2^16, nothing borrowed from the low half by the
+/// high one: bit 15 set in `a`'s halves and clear in `b`'s, so bits 0 to 14 of a half
+/// subtract without a borrow out of it, and bit 15 of each half is then put right (`a15 ^
+/// b15 ^` the borrow into bit 15, which the subtraction leaves as `!` its bit 15).
+#[inline(always)]
+const fn sub_halves(a: u32, b: u32) -> u32 {
+    ((a | HALF_TOPS).wrapping_sub(b & !HALF_TOPS)) ^ (!(a ^ b) & HALF_TOPS)
+}
+
+/// `a + b` half by half, each half modulo 2^16, nothing carried from the low half into
+/// the high one: bits 0 to 14 of the halves added (at most 0xFFFE a half), bit 15 of each
+/// half then `a15 ^ b15 ^` the carry into it.
+#[inline(always)]
+const fn add_halves(a: u32, b: u32) -> u32 {
+    ((a & !HALF_TOPS).wrapping_add(b & !HALF_TOPS)) ^ ((a ^ b) & HALF_TOPS)
+}
+
+/// [`EncoderCheck::sample`]'s steps with the window's bias, `c_k - c_{k-1} + m` (`c_{-1}`
+/// the `last` count), two to a word as [`steps_ored_portable`] computes them, the four
+/// words ORed. On the Cortex-M4 a Thumb-2 kernel (`acquisition/thumb.rs`: `usub16` and
+/// `uadd16`, the halves apart in the instruction itself; `cargo qemu-core` checks the
+/// fast path against the count by count one there); the host runs the portable arithmetic.
+#[inline(always)]
+pub fn steps_ored(latched: &[u16; OVERSAMPLING], last: u16, bias: u32) -> u32 {
+    #[cfg(target_arch = "arm")]
+    let out = super::thumb::steps_ored(latched, last, bias);
+    #[cfg(not(target_arch = "arm"))]
+    let out = steps_ored_portable(latched, last, bias);
+    out
+}
+
+/// [`steps_ored`] in Rust alone, on every target: the words `(c_{2j}, c_{2j+1})` and
+/// `(c_{2j-1}, c_{2j})` one trigger earlier, `w - b + bias` half by half ([`sub_halves`],
+/// [`add_halves`]: nothing borrowed or carried from one half into the other), ORed.
+#[inline(always)]
+pub fn steps_ored_portable(latched: &[u16; OVERSAMPLING], last: u16, bias: u32) -> u32 {
+    let [c0, c1, c2, c3, c4, c5, c6, c7] = *latched;
+    let [w0, w1, w2, w3] = [word(c0, c1), word(c2, c3), word(c4, c5), word(c6, c7)];
+    // Each word's counts one trigger earlier: (c_{2j-1}, c_{2j}).
+    let [b0, b1, b2, b3] = [
+        u32::from(last) | (w0 << 16),
+        (w0 >> 16) | (w1 << 16),
+        (w1 >> 16) | (w2 << 16),
+        (w2 >> 16) | (w3 << 16),
+    ];
+    let steps = |w: u32, b: u32| add_halves(sub_halves(w, b), bias);
+    steps(w0, b0) | steps(w1, b1) | steps(w2, b2) | steps(w3, b3)
+}
+
 /// The largest `max_step` for which [`EncoderCheck::sample`]'s fast path is exact: a
 /// sample's counts then lie within `7 x max_step` of its first, and their differences
 /// from it sum to at most `28 x max_step` (1 + 2 + ... + 7), within an `i16`.
@@ -256,37 +309,25 @@ impl EncoderCheck {
     /// speed forwards, a little less backwards: every sample but a glitch's, the one after a
     /// restart, and with a `max_step` beyond [`FAST_MAX_STEP`] every one) take the fast
     /// path: two steps a 32-bit word, `(c1, c2) - (c0, c1)`, a subtraction and an add of the
-    /// window's bias whose halves are the steps within the window, ORed and tested once; no
-    /// branch, no division (a borrow between the halves comes with a carry that cancels it
-    /// whenever the low half is within the window, and fails the test otherwise). Any other
-    /// sample goes count by count ([`EncoderCheck::check_sample`]).
+    /// window's bias half by half, whose halves are the steps within the window, ORed and
+    /// tested once ([`steps_ored`]); no branch, no division. Nothing is borrowed or carried
+    /// from one half into the other: a plain 32-bit subtraction borrowed from the high half
+    /// when the low half's step went forwards through the counter's wrap (65 535 -> 0), and
+    /// a step of `max_step + 1` in the high half then passed as motion. Any other sample
+    /// goes count by count ([`EncoderCheck::check_sample`]).
     #[inline(always)]
     pub fn sample(&mut self, latched: &[u16; OVERSAMPLING]) -> (u16, u8) {
         const { assert!(OVERSAMPLING == 8) };
         if !self.ready {
             return self.sample_slow(latched);
         }
-        let [c0, c1, c2, c3, c4, c5, c6, c7] = *latched;
-        let [w0, w1, w2, w3] = [word(c0, c1), word(c2, c3), word(c4, c5), word(c6, c7)];
-        // Each word's counts one trigger earlier: (c_{2j-1}, c_{2j}).
-        let before = [
-            u32::from(self.last) | (w0 << 16),
-            (w0 >> 16) | (w1 << 16),
-            (w1 >> 16) | (w2 << 16),
-            (w2 >> 16) | (w3 << 16),
-        ];
-        let bias = self.window_bias;
-        let steps = |w: u32, b: u32| w.wrapping_sub(b).wrapping_add(bias);
-        let [b0, b1, b2, b3] = before;
-        let out = steps(w0, b0) | steps(w1, b1) | steps(w2, b2) | steps(w3, b3);
+        let out = steps_ored(latched, self.last, self.window_bias);
         if out & self.window_mask != 0 {
             return self.sample_slow(latched);
         }
-        let (first, last, before_last) = (
-            (w0 & 0xFFFF) as u16,
-            (w3 >> 16) as u16,
-            (w3 & 0xFFFF) as u16,
-        );
+        let [c0, c1, c2, c3, c4, c5, c6, c7] = *latched;
+        let [w0, w1, w2, w3] = [word(c0, c1), word(c2, c3), word(c4, c5), word(c6, c7)];
+        let (first, last, before_last) = (c0, c7, c6);
         // Every step within `max_step`: the differences from the first count sum to
         // `sum - 8 first` within an i16 ([`FAST_MAX_STEP`]); their mean rounded as
         // `sample_count` rounds it, `floor((d + 4) / 8)`.
@@ -341,124 +382,7 @@ std::thread_local! {
     static SLOW_SAMPLES: core::cell::Cell<u32> = const { core::cell::Cell::new(0) };
 }
 
+// The checks' own tests, which reach the fast path and its parts: a file of their own.
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Steady motion at any speed within the window takes the fast path, sample after
-    /// sample, forwards and backwards, across the counter's wrap; a sample whose steps are
-    /// beyond the maximum speed, all of them or four in a row, takes the count by count one
-    /// (which rejects them) and gives its counts (away from the wrap: see the window's test).
-    #[test]
-    fn motion_within_the_window_takes_the_fast_path_and_beyond_it_the_slow_one() {
-        let slow = || SLOW_SAMPLES.with(core::cell::Cell::get);
-        for max_step in [1u16, 4, 9, 100, FAST_MAX_STEP] {
-            let max = i32::from(max_step);
-            let m = (1 << window_bits(max_step)) - 1 - max;
-            let speeds = [-m, -1, 0, 1, max / 2, max];
-            for speed in speeds.into_iter().filter(|s| (-m..=max).contains(s)) {
-                let mut check = EncoderCheck::new(max_step);
-                let mut count = 65_000u16;
-                let next = |count: &mut u16| -> [u16; OVERSAMPLING] {
-                    std::array::from_fn(|_| {
-                        *count = count.wrapping_add(speed as u16);
-                        *count
-                    })
-                };
-                check.sample(&next(&mut count));
-                for k in 0..40 {
-                    let latched = next(&mut count);
-                    let mut reference = check;
-                    let want = reference.sample_slow(&latched);
-                    let went_slow = slow();
-                    assert_eq!(check.sample(&latched), want, "max {max_step} speed {speed}");
-                    assert_eq!(
-                        slow(),
-                        went_slow,
-                        "max {max_step} speed {speed}: sample {k}"
-                    );
-                }
-                // Beyond the maximum speed: every step, then four of a sample's steps, the
-                // first, the middle or the last (its words' steps two by two).
-                for beyond in [0..8, 0..4, 2..6, 4..8] {
-                    // Away from the counter's wrap (see the window's test).
-                    check.restart();
-                    count = 30_000;
-                    check.sample(&next(&mut count));
-                    let mut latched = [0u16; OVERSAMPLING];
-                    let mut at = check.last;
-                    for (j, c) in latched.iter_mut().enumerate() {
-                        let step = if beyond.contains(&j) { max + 1 } else { speed };
-                        at = at.wrapping_add(step as u16);
-                        *c = at;
-                    }
-                    let mut reference = check;
-                    let want = reference.sample_slow(&latched);
-                    assert_eq!(want.1, beyond.len() as u8, "max {max_step}: {latched:?}");
-                    let went_slow = slow();
-                    assert_eq!(check.sample(&latched), want, "max {max_step}: {latched:?}");
-                    assert_eq!(slow(), went_slow + 1, "max {max_step}: {latched:?}");
-                }
-            }
-        }
-    }
-
-    /// The fast path's bound and window as [`EncoderCheck`]'s docs give them: `b` the largest with
-    /// `2^b <= 2 max_step + 1` (spans 1, 3, 9, 19, 201, 2 341, 65 535, 131 071), at most 15; two
-    /// steps in a word pass its test exactly when both lie within `-m..=max_step`, `m = 2^b - 1 -
-    /// max_step`, away from the counter's wrap. (A narrower window is no error, the count by count
-    /// path gives the same counts, but every sample beyond it pays for that path: the sample task's
-    /// budget counts on the fast one.) At the wrap a step into it borrows from or carries into the
-    /// next half, which then passes one count off: not tested here (docs/firmware.md, the
-    /// survivors of `checks.rs`).
-    #[test]
-    fn the_fast_paths_window_is_the_documented_one() {
-        // The fast path's largest step: 28 x 1 170 = 32 760 fits an i16, 28 x 1 171 not.
-        assert_eq!(FAST_MAX_STEP, 1_170);
-        let bits = [
-            (0, 0),
-            (1, 1),
-            (4, 3),
-            (9, 4),
-            (100, 7),
-            (FAST_MAX_STEP, 11),
-        ];
-        for (max_step, b) in bits.into_iter().chain([(u16::MAX / 2, 15), (u16::MAX, 15)]) {
-            assert_eq!(window_bits(max_step), b, "max {max_step}");
-        }
-        for (max_step, b) in bits.into_iter().skip(1) {
-            let check = EncoderCheck::new(max_step);
-            let max = i32::from(max_step);
-            let m = (1 << b) - 1 - max;
-            // Motion backwards is believed a little less far, never further.
-            assert!((0..=max).contains(&m), "max {max_step}: m {m}");
-            let steps = [
-                -m - 2,
-                -m - 1,
-                -m,
-                -m + 1,
-                -1,
-                0,
-                1,
-                max - 1,
-                max,
-                max + 1,
-                max + 2,
-            ];
-            let within = |s: i32| (-m..=max).contains(&s);
-            for first in [5_000u16, 30_000, 65_000 - 8 * max_step] {
-                for s1 in steps {
-                    for s2 in steps {
-                        let c1 = first.wrapping_add(s1 as u16);
-                        let c2 = c1.wrapping_add(s2 as u16);
-                        let (now, before) = (word(c1, c2), word(first, c1));
-                        let out = now.wrapping_sub(before).wrapping_add(check.window_bias);
-                        let passes = out & check.window_mask == 0;
-                        let want = within(s1) && within(s2);
-                        assert_eq!(passes, want, "max {max_step}: {first} {s1} {s2}");
-                    }
-                }
-            }
-        }
-    }
-}
+#[path = "checks_tests.rs"]
+mod tests;

@@ -10,7 +10,8 @@ use crate::flash_record::CalibrationRecord;
 use crate::offset_trim::{OffsetTrim, TrimKind, TrimResult, REPORT_STEP_CODES};
 use crate::sampling::{AdcSampler, Clipped, RawFrame, SamplingError};
 use monitor_core::{
-    CommissioningError, ConfigError, Fault, Install, Monitor, MonitorConfig, SteadyPoint,
+    CommissioningError, ConfigError, Fault, Install, Monitor, MonitorConfig, MonitorOutput,
+    SteadyPoint,
 };
 
 /// Why the application could not be built.
@@ -304,17 +305,7 @@ impl SamplePath {
     /// The status for thread mode, from the latest output.
     pub fn status(&self) -> MonitorStatus {
         let o = self.monitor.output();
-        let top = o.top();
-        let second = o
-            .diagnosis
-            .probabilities
-            .iter()
-            .zip(Fault::ALL)
-            .filter(|(p, f)| **p > 0.0 && Some(*f) != top.map(|t| t.0))
-            .fold(None::<(Fault, f32)>, |best, (p, f)| match best {
-                Some((_, bp)) if bp >= *p => best,
-                _ => Some((f, *p)),
-            });
+        let (top, second) = candidates(o);
         MonitorStatus {
             samples: self.samples,
             residuals: o.residuals,
@@ -401,4 +392,25 @@ impl FrameBuilder {
             encoder_rejects: b.encoder_rejects,
         }
     }
+}
+
+/// A candidate of the status: a fault and its probability, or none.
+type StatusCandidate = Option<(Fault, f32)>;
+
+/// The status's two candidates from the core's output: the most probable fault
+/// ([`MonitorOutput::top`]) and the most probable after it, the first of equals as the
+/// top's; each only with a probability above zero.
+pub(super) fn candidates(o: &MonitorOutput) -> (StatusCandidate, StatusCandidate) {
+    let top = o.top();
+    let second = o
+        .diagnosis
+        .probabilities
+        .iter()
+        .zip(Fault::ALL)
+        .filter(|(p, f)| **p > 0.0 && Some(*f) != top.map(|t| t.0))
+        .fold(None::<(Fault, f32)>, |best, (p, f)| match best {
+            Some((_, bp)) if bp >= *p => best,
+            _ => Some((f, *p)),
+        });
+    (top, second)
 }

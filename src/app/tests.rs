@@ -141,3 +141,25 @@ fn before_any_sample_the_status_names_no_candidate() {
         .status();
     assert_eq!((status.top, status.second), (None, None));
 }
+
+/// The status's second candidate is the most probable fault after the top one, not the
+/// first after it in [`Fault::ALL`]'s order, and of two equally probable the first, as the
+/// top is: core outputs with three and four positive probabilities, the runner-up after
+/// a less probable one, before and after the top.
+#[test]
+fn the_second_candidate_is_the_runner_up_not_the_first_named() {
+    use monitor_core::{Fault, MonitorOutput};
+    let f = Fault::ALL;
+    let cases: [(&[f32], (usize, usize)); 4] = [
+        (&[0.1, 0.3, 0.6], (2, 1)),
+        (&[0.05, 0.6, 0.1, 0.25], (1, 3)),
+        (&[0.2, 0.1, 0.3, 0.4], (3, 2)),
+        (&[0.3, 0.4, 0.3], (1, 0)),
+    ];
+    for (given, (top, second)) in cases {
+        let mut o = MonitorOutput::default();
+        o.diagnosis.probabilities[..given.len()].copy_from_slice(given);
+        let want = (Some((f[top], given[top])), Some((f[second], given[second])));
+        assert_eq!(sample_path::candidates(&o), want, "{given:?}");
+    }
+}

@@ -333,3 +333,39 @@ fn an_exceptions_number_is_written_as_a_sign_and_three_decimal_digits() {
         assert_eq!(rec.file(), file, "{irqn:?}");
     }
 }
+
+/// The counts kept in RAM (`log::Pending`): a slot naming no reset's kind (6, the log's
+/// "up" count, 7, 15) or no count (0, its flags set) is free, so nothing of it is counted,
+/// written or taken for a safe mode; a count goes to the slot that holds its kind and
+/// flags, even with a free slot before it.
+#[test]
+fn a_pending_slot_naming_no_kind_or_no_count_is_free() {
+    use log::{Pending, Totals, PENDING_LEN};
+    let slot = |what: u8, count: u16| {
+        let [c0, c1] = count.to_le_bytes();
+        [what, 0, c0, c1]
+    };
+    let mut bytes = [0u8; PENDING_LEN];
+    for (b, s) in bytes.chunks_exact_mut(4).zip([
+        slot(6, 1),
+        slot(7 | 0x40, 2),
+        slot(15 | 0x80, 3),
+        slot(ResetKind::Watchdog.index() as u8 | 0xC0, 0),
+    ]) {
+        b.copy_from_slice(&s);
+    }
+    let pending = Pending::decode(&bytes);
+    assert_eq!(pending, Pending::EMPTY);
+    assert_eq!(pending.count(), 0);
+    assert!(!pending.holds_safe_mode());
+    assert_eq!(pending.added_to(Totals::default()), Totals::default());
+    // A free slot, then a power-on's (kind 0, no flags) count of 2: the next power-on
+    // makes it 3, in its own slot; the free one stays free.
+    let mut bytes = [0u8; PENDING_LEN];
+    bytes[4..8].copy_from_slice(&slot(ResetKind::PowerOn.index() as u8, 2));
+    let mut pending = Pending::decode(&bytes);
+    assert!(pending.add(ResetKind::PowerOn, false, false));
+    let mut want = [0u8; PENDING_LEN];
+    want[4..8].copy_from_slice(&slot(ResetKind::PowerOn.index() as u8, 3));
+    assert_eq!(pending.encode(), want);
+}
