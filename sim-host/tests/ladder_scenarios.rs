@@ -40,6 +40,13 @@ fn ladder_on_scenario(effect: &str, dir: &Path) -> serde_json::Value {
 /// `simulate` of `scenario` on the machine of `params` into `log`, then `explain --ladder
 /// --json` on it from `from` s: the JSON document.
 fn simulate_and_climb(params: &Path, scenario: &Path, log: &Path, from: &str) -> serde_json::Value {
+    simulate(params, scenario, log);
+    let ladder = ["explain", "--ladder", "--json", "--from", from, "--params"];
+    run_json(&ladder, params, log, scenario)
+}
+
+/// `simulate` of `scenario` on the machine of `params` into `log`.
+fn simulate(params: &Path, scenario: &Path, log: &Path) {
     Command::cargo_bin("sim-host")
         .unwrap()
         .args(["simulate", "--params"])
@@ -50,9 +57,14 @@ fn simulate_and_climb(params: &Path, scenario: &Path, log: &Path, from: &str) ->
         .arg(log)
         .assert()
         .success();
+}
+
+/// `sim-host <args> <params> <log>` (the arguments end with `--params`): its JSON document;
+/// a failure names `scenario`.
+fn run_json(args: &[&str], params: &Path, log: &Path, scenario: &Path) -> serde_json::Value {
     let out = Command::cargo_bin("sim-host")
         .unwrap()
-        .args(["explain", "--ladder", "--json", "--from", from, "--params"])
+        .args(args)
         .arg(params)
         .arg(log)
         .output()
@@ -361,31 +373,11 @@ fn the_voltages_noise_does_not_warm_the_motor() {
         let scenario = dir.path().join(format!("long_{warming}.toml"));
         let log = dir.path().join(format!("long_{warming}.csv"));
         std::fs::write(&scenario, long_scenario(warming, 200.0, 0.05)).unwrap();
-        Command::cargo_bin("sim-host")
-            .unwrap()
-            .args(["simulate", "--params"])
-            .arg(&params)
-            .arg("--scenario")
-            .arg(&scenario)
-            .arg("--out")
-            .arg(&log)
-            .assert()
-            .success();
-        let out = Command::cargo_bin("sim-host")
-            .unwrap()
-            .args(["compare", "--json", "--effects"])
-            .arg("current_dynamics,flux_dynamics,d_axis_dynamics,cross_coupling_dynamics,thermal_drift")
-            .arg("--params")
-            .arg(&params)
-            .arg(&log)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        simulate(&params, &scenario, &log);
+        let effects =
+            "current_dynamics,flux_dynamics,d_axis_dynamics,cross_coupling_dynamics,thermal_drift";
+        let compare = ["compare", "--json", "--effects", effects, "--params"];
+        let v = run_json(&compare, &params, &log, &scenario);
         let drift = v["fitted_effects"]
             .as_array()
             .unwrap()
