@@ -402,8 +402,8 @@ pub fn fit_spec(
     let mut f = result_at(effects, &x, report)?;
     // Only where the biased effect's values move: a screening fit that holds the model's
     // values (and its drift among them) reads nothing the noise biases.
-    let moved = effects.iter().skip(spec.hold_first);
-    if moved.into_iter().any(|e| e.effect.biased_by_input_noise()) {
+    let mut moved = effects.iter().skip(spec.hold_first);
+    if moved.any(|e| e.effect.biased_by_input_noise()) {
         if let Some(c) = simex::corrected(d, renoised, &x, &bounds, &free, max_iter) {
             f.corrected = Some(result_at(effects, &c, report)?.effect_params);
         }
