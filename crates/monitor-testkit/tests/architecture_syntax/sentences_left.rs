@@ -164,5 +164,4 @@ pub const SENTENCES_LEFT: &[(&str, usize, &str)] = &[
     ("crates/monitor-store/src/store.rs", 4, STORE),
     ("crates/monitor-store/src/trend/mod.rs", 1, CATALOGUE),
     ("crates/monitor-studies/src/bench/isolation.rs", 1, FINDING),
-    ("crates/monitor-studies/src/fault_signatures.rs", 1, FINDING),
 ];
