@@ -282,17 +282,6 @@ pub fn candidates_text(
         .collect()
 }
 
-/// The lamps' signature candidates as `sig. rs p 0.33 / ls p 0.33` (short: the HMI's
-/// header fits 80 columns), or `sig. none` (B and Bl as one class, [`candidates_text`]).
-pub fn signature_text(candidates: impl IntoIterator<Item = (Fault, f32)>) -> String {
-    let names = candidates_text(candidates.into_iter().map(|(f, p)| (f, p, None)));
-    if names.is_empty() {
-        "sig. none".into()
-    } else {
-        format!("sig. {}", names.join(" / "))
-    }
-}
-
 #[cfg(test)]
 mod text_tests {
     use super::*;
@@ -304,15 +293,10 @@ mod text_tests {
             candidate_text("rr", 0.76, Some(0.5)),
             "rr p 0.76 (rr +50 %)"
         );
-        assert_eq!(
-            signature_text([(Fault::Rs, 1.0 / 3.0), (Fault::Ls, 1.0 / 3.0)]),
-            "sig. rs p 0.33 / ls p 0.33"
-        );
         // B and Bl: one friction class with Bl's size (a Bl +50 % fault reads as B +300 %).
         assert_eq!(
             candidates_text([(Fault::B, 0.5, Some(3.0)), (Fault::Bl, 0.5, Some(0.5))]),
             ["b/bl p 1.00 (b/bl +50 %)"]
         );
-        assert_eq!(signature_text([]), "sig. none");
     }
 }

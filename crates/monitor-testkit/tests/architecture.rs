@@ -30,13 +30,24 @@
 //!    team's design file or its shared folder ([`FOREIGN`]); a user who clones the
 //!    repository has neither. The paper is cited by its title, the design by `docs/`.
 //!
-//! 8. **Spelled only at the door**: an engine's non-test sources (`monitor-analysis`) name
-//!    none of the front ends' words (`Spelling`, `Words`, `OptionField`) and decide nothing
-//!    by reading a sentence back (`t.because.starts_with("...")`): its reasons are typed
-//!    values, spelled by `monitor-words` (`architecture_syntax::spelling`, with its tests).
+//! 8. **Spelled only at the door**: an engine's non-test sources (every engine crate,
+//!    `architecture_syntax::spelling::ENGINES`: the core, io, laws, sim, replay, analysis,
+//!    store, studies) name none of the front ends' words (`Spelling`, `Words`,
+//!    `OptionField`) and decide nothing by reading a sentence back
+//!    (`t.because.starts_with("...")`): its reasons are typed values, spelled by
+//!    `monitor-words` (`architecture_syntax::spelling`, with its tests).
+//! 9. **No engine builds a sentence**: no string of prose (two words side by side, plain
+//!    or a `format!`/`write!`/`writeln!`/`concat!` template) in an engine's code but an
+//!    error's `#[error("...")]`, a `Display`/`Debug` impl and a programmer's message
+//!    (`panic!`, `assert!`, `.expect`), and the files of `SENTENCES_LEFT`
+//!    (`architecture_syntax::sentences`, which says why, with its tests).
 //!
 //! The tests' shared scenarios (`crates/monitor-testkit/src/`, a dev-only crate) are tests
-//! for rule 4 and for the unique type names (rule 7, below), and code for the others.
+//! for rule 4 and for the unique type names (rule 7, below), and code for the others. A
+//! test is a file of `tests/` or `benches/` folders, a `tests.rs` or `*_tests.rs`, and an
+//! item carrying `#[cfg(test)]` or `#[test]` wherever it stands: every rule reads the code
+//! after a file's first `#[cfg(test)]` (`architecture_syntax::files::code_lines`, the syntax
+//! walks skip the test items only).
 //!
 //! The files are those git tracks (`git ls-files`), or, without git, every file below the
 //! workspace outside `target/` and hidden folders.
@@ -45,33 +56,15 @@ mod architecture_syntax;
 
 use architecture_syntax::allowances::{LONG_FILES, LONG_FUNCTIONS};
 use architecture_syntax::circles::{circles, reached, ModPath};
+use architecture_syntax::crates::{CRATE_SOURCES, WORKSPACE_CRATES};
 use architecture_syntax::files::{
-    crate_sources, files, is_code, is_shared_scenarios, is_test_file, packages, parse, read,
-    verdict, workspace,
+    code_lines, crate_sources, files, is_code, is_shared_scenarios, is_test_file, packages, parse,
+    read, verdict, workspace,
 };
 use architecture_syntax::layers::INSIDE;
 use architecture_syntax::{module_of, top_module, LongFunctions, Paths};
 
 use syn::visit::Visit;
-
-/// The `src/` folders that must be among those checked for import circles (which are
-/// found from the workspace's packages, [`crate_sources`]): every library crate of the
-/// host and the firmware, the tests' shared scenarios, and the command line.
-const CRATE_SOURCES: [&str; 13] = [
-    "src/",
-    "crates/monitor-core/src/",
-    "crates/monitor-io/src/",
-    "crates/monitor-laws/src/",
-    "crates/monitor-sim/src/",
-    "crates/monitor-replay/src/",
-    "crates/monitor-analysis/src/",
-    "crates/monitor-studies/src/",
-    "crates/monitor-api/src/",
-    "crates/monitor-store/src/",
-    "crates/monitor-words/src/",
-    "crates/monitor-testkit/src/",
-    "sim-host/src/",
-];
 
 /// Import circles still there: (crate's `src/`, the files as `a::b` paths, why). An entry
 /// no longer found fails the test (the list only shrinks).
@@ -84,29 +77,6 @@ const MAX_FN_LINES: usize = 60;
 /// References to files outside the repository (spelled in two parts, so that this file
 /// does not hold them).
 const FOREIGN: [&str; 2] = [concat!("DESIGN", ".md"), concat!("..", "/shared")];
-/// The workspace's crates by the names code uses (every package, checked by
-/// [`the_crate_list_names_every_package`]).
-const WORKSPACE_CRATES: [&str; 18] = [
-    "drive_monitor",
-    "sim_host",
-    "monitor_core",
-    "monitor_io",
-    "monitor_laws",
-    "monitor_sim",
-    "monitor_replay",
-    "monitor_analysis",
-    "monitor_studies",
-    "monitor_api",
-    "monitor_words",
-    "monitor_store",
-    "monitor_testkit",
-    "core_on_m4",
-    "rtt_on_m4",
-    "qemu_semihosting",
-    "drive_monitor_python",
-    "fwtool",
-];
-
 /// The layer of `module` inside the crate of `table` (the base, 1, when not listed).
 fn layer(table: &[(&str, u8)], module: &str) -> u8 {
     table
@@ -520,12 +490,11 @@ fn no_string_errors_in_the_library() {
             continue;
         }
         let text = std::fs::read_to_string(root.join(&f)).unwrap_or_default();
-        // (A file's test module, at its end, is a test.)
-        let code = text.split("#[cfg(test)]\nmod tests").next().unwrap_or("");
-        for (k, line) in code.lines().enumerate() {
+        // (A file's test items, wherever they stand, are tests; the code after them is not.)
+        for (n, line) in code_lines(&f, &text) {
             let compact: String = line.split_whitespace().collect();
             if compact.contains("Result<") && compact.contains(",String>") {
-                bad.push(format!("{f}:{}: {}", k + 1, line.trim()));
+                bad.push(format!("{f}:{n}: {}", line.trim()));
             }
         }
     }
@@ -557,8 +526,7 @@ fn no_type_name_is_defined_twice() {
             continue;
         }
         let text = std::fs::read_to_string(root.join(&f)).unwrap_or_default();
-        let code = text.split("#[cfg(test)]\nmod tests").next().unwrap_or("");
-        for (k, line) in code.lines().enumerate() {
+        for (n, line) in code_lines(&f, &text) {
             // (An indented `type` is an associated type of an impl or trait, not a
             // definition of its own.)
             if line.trim_start().starts_with("type ") && line.starts_with(char::is_whitespace) {
@@ -579,7 +547,7 @@ fn no_type_name_is_defined_twice() {
                 .chars()
                 .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
                 .collect();
-            seen.entry(name).or_default().push(format!("{f}:{}", k + 1));
+            seen.entry(name).or_default().push(format!("{f}:{n}"));
         }
     }
     let twice: Vec<String> = seen

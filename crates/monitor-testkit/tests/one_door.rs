@@ -14,27 +14,18 @@
 //!    text, nor searches or strips it: a decision reads the typed reason.
 //!
 //! The files are those of the workspace's code folders (git's list), tests excluded
-//! (`tests/` folders, benches, and `#[cfg(test)]` modules).
+//! (`tests/` folders, benches, and the items carrying `#[cfg(test)]` or `#[test]`, wherever
+//! they stand: the code after them is read).
 
 // The architecture suite's file walker; only part of it is used here.
 #[allow(dead_code)]
 mod architecture_syntax;
 
 use architecture_syntax::files::{files, is_code, is_test_file, read, verdict};
+// The engine crates: they return typed values, never a front end's words.
+use architecture_syntax::spelling::ENGINES;
 use syn::spanned::Spanned;
 use syn::visit::Visit;
-
-/// The engine crates: they return typed values, never a front end's words.
-const ENGINES: [&str; 8] = [
-    "crates/monitor-core/src/",
-    "crates/monitor-io/src/",
-    "crates/monitor-laws/src/",
-    "crates/monitor-sim/src/",
-    "crates/monitor-replay/src/",
-    "crates/monitor-analysis/src/",
-    "crates/monitor-store/src/",
-    "crates/monitor-studies/src/",
-];
 
 /// The door.
 const DOOR: &str = "crates/monitor-words/src/";
@@ -42,17 +33,13 @@ const DOOR: &str = "crates/monitor-words/src/";
 /// The names of the words a front end spells the library's fields in.
 const WORDS_TYPES: [&str; 3] = ["Spelling", "FieldNames", "Words"];
 
-/// The code lines of `text` outside `#[cfg(test)]` modules (a module's lines from its
-/// attribute to the end of the file: the workspace keeps its test modules last).
-fn code_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
-    text.lines()
-        .enumerate()
-        .take_while(|(_, l)| l.trim() != "#[cfg(test)]")
-        .filter(|(_, l)| {
-            let t = l.trim_start();
-            !(t.starts_with("//") || t.starts_with("///") || t.starts_with("//!"))
-        })
-        .map(|(k, l)| (k + 1, l))
+/// The code lines of `text` (the source of `rel`) outside its tests and comments: the
+/// items carrying `#[cfg(test)]` or `#[test]` are left out wherever they stand, and the
+/// code after them is read (`architecture_syntax::files::code_lines`).
+fn code_lines<'t>(rel: &str, text: &'t str) -> impl Iterator<Item = (usize, &'t str)> {
+    architecture_syntax::files::code_lines(rel, text)
+        .into_iter()
+        .filter(|(_, l)| !l.trim_start().starts_with("//"))
 }
 
 /// Whether `line` names `word` as a whole identifier.
@@ -81,7 +68,7 @@ fn engines_naming_words(rels: &[String], text: &dyn Fn(&str) -> String) -> Vec<S
     let mut bad = Vec::new();
     for rel in rels {
         let t = text(rel);
-        for (n, line) in code_lines(&t) {
+        for (n, line) in code_lines(rel, &t) {
             for w in WORDS_TYPES {
                 if names(line, w) {
                     bad.push(format!("{rel}:{n}: names {w}: {}", line.trim()));
@@ -102,7 +89,8 @@ fn the_words_are_spelled_in_one_crate() {
         if rel.starts_with(DOOR) {
             continue;
         }
-        for (n, line) in code_lines(&read(&rel)) {
+        let text = read(&rel);
+        for (n, line) in code_lines(&rel, &text) {
             let t = line.trim_start();
             if t.starts_with("pub trait Spelling")
                 || t.starts_with("trait Spelling")
@@ -208,7 +196,7 @@ const ASKS: [&str; 8] = [
 /// Rule 3's violations in `text` (of `rel`): a sentence-like value asked about its text.
 fn sentences_read_back(rel: &str, text: &str) -> Vec<String> {
     let mut bad = Vec::new();
-    for (n, line) in code_lines(text) {
+    for (n, line) in code_lines(rel, text) {
         for ask in ASKS {
             for (at, _) in line.match_indices(ask) {
                 // The receiver: the identifier (with field accesses) just before the call.
@@ -256,7 +244,7 @@ fn the_rules_catch_what_they_should() {
     let t = "pub struct A {\n    pub words: Words,\n    spell: &'static (dyn Spelling + Sync),\n}\nenum B { C { sp: Option<Words> } }\nfn f(sp: &dyn Spelling) {}\n#[cfg(test)]\nmod tests { struct D { w: Words } }\n";
     assert_eq!(fields_holding_words("a.rs", t).len(), 3, "{t}");
     // Rule 3: a reason read back, the ladder's old refusal among them; a name asked about
-    // its text and test code are not.
-    let t = "if !t.because.starts_with(\"not physical\") {}\nlet x = why.as_str().contains(\"y\");\nlet ok = name.starts_with(\"a\");\n#[cfg(test)]\nmod tests { fn f() { why.contains(\"z\"); } }\n";
-    assert_eq!(sentences_read_back("a.rs", t).len(), 2, "{t}");
+    // its text and test code are not; the code after a test module is read.
+    let t = "fn f() {\n    if !t.because.starts_with(\"not physical\") {}\n    let x = why.as_str().contains(\"y\");\n    let ok = name.starts_with(\"a\");\n}\n#[cfg(test)]\nmod tests { fn f() { why.contains(\"z\"); } }\nfn g() -> bool { summary.ends_with(\".\") }\n";
+    assert_eq!(sentences_read_back("a.rs", t).len(), 3, "{t}");
 }

@@ -503,6 +503,20 @@ pub fn state_text(state: &MonitorState, candidates: &[(Fault, f32)]) -> String {
     state_words(state, candidates, true)
 }
 
+/// The lamps' signature candidates as `sig. rs p 0.33 / ls p 0.33` (short: the header fits
+/// 80 columns), or `sig. none` (B and Bl as one class,
+/// `monitor_studies::fault_signatures::candidates_text`).
+fn signature_text(candidates: impl IntoIterator<Item = (Fault, f32)>) -> String {
+    let names = monitor_studies::fault_signatures::candidates_text(
+        candidates.into_iter().map(|(f, p)| (f, p, None)),
+    );
+    if names.is_empty() {
+        "sig. none".into()
+    } else {
+        format!("sig. {}", names.join(" / "))
+    }
+}
+
 /// [`state_text`], a fault's state without the word FAULT where `fault_word` is false.
 fn state_words(state: &MonitorState, candidates: &[(Fault, f32)], fault_word: bool) -> String {
     match state {
@@ -511,9 +525,7 @@ fn state_words(state: &MonitorState, candidates: &[(Fault, f32)], fault_word: bo
         MonitorState::Starting => "starting (settling)".to_string(),
         MonitorState::Healthy => "healthy".to_string(),
         MonitorState::Fault(_) => {
-            let sig = monitor_studies::fault_signatures::signature_text(
-                candidates.iter().map(|(f, p)| (*f, *p)),
-            );
+            let sig = signature_text(candidates.iter().map(|(f, p)| (*f, *p)));
             if fault_word {
                 format!("FAULT ({sig})")
             } else {

@@ -482,3 +482,17 @@ fn a_named_fault_stands_alone_in_the_state() {
         )
     );
 }
+
+/// The lamps' signature in the header: the candidates, B and Bl as one class, or none.
+#[test]
+fn the_signature_is_spelled_by_the_hmi() {
+    assert_eq!(
+        crate::hmi::signature_text([(Fault::Rs, 1.0 / 3.0), (Fault::Ls, 1.0 / 3.0)]),
+        "sig. rs p 0.33 / ls p 0.33"
+    );
+    assert_eq!(
+        crate::hmi::signature_text([(Fault::B, 0.5), (Fault::Bl, 0.5)]),
+        "sig. b/bl p 1.00"
+    );
+    assert_eq!(crate::hmi::signature_text([]), "sig. none");
+}

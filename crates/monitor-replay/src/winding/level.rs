@@ -79,24 +79,6 @@ pub struct ShortedTurns {
     pub loop_ratio: f32,
 }
 
-impl ShortedTurns {
-    /// `shorted turns in phase c: about 30 % of the phase's turns (22-38 %), from
-    /// physics`.
-    pub fn sentence(&self) -> String {
-        let by = match self.basis {
-            LevelBasis::Physics => "from the model (no labels)",
-            LevelBasis::Calibration => "from the calibration of labelled runs",
-        };
-        format!(
-            "shorted turns in phase {}: about {:.0} % of the phase's turns ({:.0}-{:.0} %), {by}",
-            self.phase.name(),
-            100.0 * self.fraction,
-            100.0 * self.low,
-            100.0 * self.high
-        )
-    }
-}
-
 /// The loop ratio `r` of the judged stretch and its uncertainty on `|r|` (two spreads,
 /// mapped as `r` is), for the named phase; `None` without a named phase or a judged
 /// stretch.

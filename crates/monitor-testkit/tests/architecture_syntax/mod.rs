@@ -6,17 +6,28 @@
 
 pub mod allowances;
 pub mod circles;
+pub mod crates;
 pub mod files;
 pub mod layers;
+pub mod sentences;
+pub mod sentences_left;
 pub mod spelling;
 
 use syn::visit::Visit;
 
-/// True for `#[cfg(test)]` (or a `cfg` naming `test`) and `#[test]`.
+/// True for `#[cfg(test)]` (or a `cfg` naming `test` that only tests build, `all(test, ..)`)
+/// and `#[test]`; not for `cfg(not(test))` nor `cfg(any(test, ..))`, which other builds
+/// compile too.
 pub fn is_cfg_test(attrs: &[syn::Attribute]) -> bool {
     attrs.iter().any(|a| {
-        (a.path().is_ident("cfg")
-            && matches!(&a.meta, syn::Meta::List(l) if l.tokens.to_string().split(|c: char| !c.is_alphanumeric() && c != '_').any(|w| w == "test")))
+        let cfg = match &a.meta {
+            syn::Meta::List(l) if a.path().is_ident("cfg") => l.tokens.to_string(),
+            _ => String::new(),
+        };
+        let words: Vec<&str> = cfg
+            .split(|c: char| !c.is_alphanumeric() && c != '_')
+            .collect();
+        (words.contains(&"test") && !words.contains(&"not") && !words.contains(&"any"))
             || a.path().is_ident("test")
     })
 }

@@ -1,20 +1,39 @@
-//! Rule 8, **spelled only at the door**: an engine crate ([`ENGINES`]) returns typed values
-//! and typed reasons; the sentences a crew reads are spelled by `monitor-words`. So an
-//! engine's non-test sources name none of the front ends' words (`Spelling`, `Words`,
-//! `OptionField`: [`WORDS`]), and decide nothing by reading a sentence back: no
+//! Rule 8, **spelled only at the door**: an engine crate (every one of [`ENGINES`])
+//! returns typed values and typed reasons; the sentences a crew reads are spelled by
+//! `monitor-words`. So an engine's non-test sources name none of the front ends' words (`Spelling`, `Words`,
+//! `FieldNames`, `OptionField`: [`WORDS`]; the replay, which defines `OptionField`, names
+//! it: [`WORD_HOMES`]), and decide nothing by reading a sentence back: no
 //! `starts_with`, `ends_with`, `contains`, `strip_prefix` or `==` of a string literal on a
 //! field or variable that holds a reason or a sentence ([`REASON_NAMES`]).
 
-use super::files::{files, is_test_file, parse, verdict};
+use super::files::{files, is_test_file, item_attrs, parse, verdict};
 use super::is_cfg_test;
 use syn::spanned::Spanned;
 use syn::visit::Visit;
 
-/// The engine crates' sources the rule covers.
-pub const ENGINES: [&str; 1] = ["crates/monitor-analysis/src/"];
+/// The engine crates' sources (every library crate but the door, `monitor-words` and
+/// `monitor-api`, and the dev-only `monitor-testkit`; docs/architecture.md, "Words at one
+/// door"): they return typed values and typed reasons. Rules 8 and 9 and `one_door.rs`
+/// read this one list.
+pub const ENGINES: [&str; 8] = [
+    "crates/monitor-core/src/",
+    "crates/monitor-io/src/",
+    "crates/monitor-laws/src/",
+    "crates/monitor-sim/src/",
+    "crates/monitor-replay/src/",
+    "crates/monitor-analysis/src/",
+    "crates/monitor-store/src/",
+    "crates/monitor-studies/src/",
+];
 
-/// The front ends' words an engine does not name.
-pub const WORDS: [&str; 3] = ["Spelling", "Words", "OptionField"];
+/// The front ends' words an engine does not name: the door's `Spelling`, `Words` and
+/// `FieldNames`, and `OptionField`, the name of an option a front end spells.
+pub const WORDS: [&str; 4] = ["Spelling", "Words", "FieldNames", "OptionField"];
+
+/// The engine that defines a word of [`WORDS`], which may name it: `OptionField` is the
+/// replay's typed name of an option (the field its `OptionError` names, the one list of
+/// `diagnose`'s options), a typed value the door spells, not a spelling.
+pub const WORD_HOMES: [(&str, &str); 1] = [("OptionField", "crates/monitor-replay/src/")];
 
 /// Names of fields and variables that hold a reason or a sentence (a name that is one of
 /// these, or ends with `_` and one of them).
@@ -79,21 +98,25 @@ impl Spelled<'_> {
 }
 
 impl<'ast> Visit<'ast> for Spelled<'_> {
-    fn visit_item_mod(&mut self, m: &'ast syn::ItemMod) {
-        if !is_cfg_test(&m.attrs) {
-            syn::visit::visit_item_mod(self, m);
+    /// (Every item carrying `#[cfg(test)]` or `#[test]` is a test; what follows it is not.)
+    fn visit_item(&mut self, i: &'ast syn::Item) {
+        if !is_cfg_test(item_attrs(i)) {
+            syn::visit::visit_item(self, i);
         }
     }
 
-    fn visit_item_fn(&mut self, f: &'ast syn::ItemFn) {
-        if !is_cfg_test(&f.attrs) {
-            syn::visit::visit_item_fn(self, f);
+    fn visit_impl_item(&mut self, i: &'ast syn::ImplItem) {
+        if !matches!(i, syn::ImplItem::Fn(f) if is_cfg_test(&f.attrs)) {
+            syn::visit::visit_impl_item(self, i);
         }
     }
 
     fn visit_ident(&mut self, i: &'ast proc_macro2::Ident) {
         let name = i.to_string();
-        if WORDS.contains(&name.as_str()) {
+        let home = WORD_HOMES
+            .iter()
+            .any(|(w, dir)| *w == name && self.rel.starts_with(dir));
+        if WORDS.contains(&name.as_str()) && !home {
             self.push(
                 i.span().start().line,
                 format!("names `{name}`: an engine returns typed values, the words are spelled at the door (monitor-words)"),
@@ -168,6 +191,13 @@ fn engines_do_not_spell_and_do_not_read_sentences_back() {
 fn the_spelling_rule_catches_what_it_should() {
     let caught = |text: &str| spelled_in("x.rs", text).len();
     assert_eq!(caught("use monitor_replay::{OptionField, Spelling};"), 2);
+    // The replay defines `OptionField`: its own name, not a front end's word there.
+    let replay = "crates/monitor-replay/src/fields.rs";
+    assert_eq!(
+        spelled_in(replay, "pub enum OptionField { Params }").len(),
+        0
+    );
+    assert_eq!(spelled_in(replay, "pub struct A { w: Words }").len(), 1);
     assert_eq!(
         caught("pub struct A { pub words: monitor_replay::Words }"),
         1
@@ -189,5 +219,10 @@ fn the_spelling_rule_catches_what_it_should() {
     assert_eq!(
         caught("#[cfg(test)]\nmod tests { fn f(t: &T) -> bool { t.summary.contains(\"x\") } }"),
         0
+    );
+    // The code after a file's first test item is read.
+    assert_eq!(
+        caught("#[cfg(test)]\nfn helper() {}\nfn f(t: &T) -> bool { t.summary.contains(\"x\") }"),
+        1
     );
 }
