@@ -266,13 +266,7 @@ fn a_long_low_rate_log_names_its_warming_and_its_control_stays_clean() {
         .iter()
         .find(|e| e["effect"] == "thermal_drift")
         .unwrap_or_else(|| panic!("no drift named: {:?}", finals(&v)));
-    for p in ["stator_rise_k", "rotor_rise_k"] {
-        let rise = drift["parameters"][p]["value"].as_f64().unwrap();
-        assert!(
-            (rise - 50.0).abs() <= 12.5,
-            "{p} {rise:.1} K, injected 50 K"
-        );
-    }
+    assert_rise_near(drift, 50.0);
     let dynamics = finals(&v).iter().any(|e| e.ends_with("_dynamics"));
     assert!(dynamics, "the dynamics refused: {:?}", finals(&v));
     let end = fin["ratio_to_floor"].as_f64().unwrap();
@@ -287,14 +281,41 @@ fn a_long_low_rate_log_names_its_warming_and_its_control_stays_clean() {
     assert!(end <= 1.2, "the control ends at {end:.2}x the floor");
 }
 
+/// The drift `drift` (a fitted effect of the JSON) rose within 25 % of `injected` K in
+/// both windings: one rise for both (`rise_k`), or the stator's and the rotor's apart.
+fn assert_rise_near(drift: &serde_json::Value, injected: f64) {
+    let p = &drift["parameters"];
+    let names: &[&str] = if p.get("rise_k").is_some() {
+        &["rise_k"]
+    } else {
+        &["stator_rise_k", "rotor_rise_k"]
+    };
+    for n in names {
+        let rise = p[n]["value"].as_f64().unwrap();
+        assert!(
+            (rise - injected).abs() <= 0.25 * injected,
+            "{n} {rise:.1} K, injected {injected} K"
+        );
+    }
+}
+
 /// The stopping rule weighs the log's length (issue 87): 40 s at 60 Hz of the 3 hp machine
 /// (2 400 supply periods) warming by 50 K ends at 1.04x the floor with the dynamics alone,
 /// inside the 1.12x band of a short log, where the ladder said "nothing is left to
-/// explain" and never tried the drift. Its band is now 1.03x: the drift is tried (named,
-/// or refused with its reason). The same log without the warming still stops at the floor
-/// with the dynamics only. Full sweeps only.
+/// explain" and never tried the drift. Its band is now 1.03x, and the drift is named: one
+/// rise for both windings (the log does not tell them apart), judged at its values
+/// corrected for the voltages' noise (SIMEX, the base refitted around them) against its own
+/// noise floor, the rise within 25 % of the 50 K injected and the chosen model within the
+/// band of its floor. The same log without the warming still stops at the floor with the
+/// dynamics only. Full sweeps only (two ladders of 80 000 samples).
+///
+/// Before: the fitted values (stator +193 K) were refused as not physical; with the test
+/// read at the log's rate they passed by passing less of the voltages' noise (1.16x their
+/// own floor, more error beyond the noise than without the drift); at the SIMEX values of
+/// the two windings apart the drift removed 5 % of the error beyond the floor (the test
+/// asks 10 %).
 #[test]
-fn a_long_log_tries_an_effect_below_the_short_logs_band() {
+fn a_long_log_names_its_drift_below_the_short_logs_band() {
     if !full() {
         return;
     }
@@ -305,50 +326,31 @@ fn a_long_log_tries_an_effect_below_the_short_logs_band() {
         from: "0",
     };
     let dir = tempfile::tempdir().unwrap();
-    let added = |s: &serde_json::Value| -> Vec<String> {
-        s["added"]
+    let finals = |v: &serde_json::Value| -> Vec<String> {
+        v["final_effects"]
             .as_array()
-            .map(|a| a.iter().map(|e| e.as_str().unwrap().to_string()).collect())
-            .unwrap_or_default()
+            .unwrap()
+            .iter()
+            .map(|e| e.as_str().unwrap().to_string())
+            .collect()
     };
     let v = ladder_on(&three_hp, true, dir.path());
-    let named = v["ladder"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .any(|s| added(s).iter().any(|e| e == "thermal_drift"));
-    // Tried on its own in the round after the dynamics: refused for a reason of its own,
-    // not because a better candidate was kept (the round that added the dynamics).
-    let judged = v["last_round"].as_array().unwrap().iter().any(|t| {
-        added(t).iter().any(|e| e == "thermal_drift") && t["refusal"]["kind"] != "better_kept"
-    });
-    assert!(
-        named || judged,
-        "the drift never judged on its own: stopped {}",
-        v["stopped_because"]
-    );
-    // Its size is corrected for the voltages' noise (SIMEX): not refused as "193 K, not
-    // physical" any more, the rise the noise alone made of it.
-    let drift = v["last_round"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|t| added(t) == ["thermal_drift"]);
-    assert!(
-        drift.is_none_or(|t| t["refusal"]["kind"] != "not_physical"),
-        "{:?}",
-        drift.map(|t| &t["refusal"])
-    );
     let band = v["test_rule"]["floor_band"].as_f64().unwrap();
     assert!(band < 1.05, "band {band}");
-    let c = ladder_on(&three_hp, false, dir.path());
-    assert_eq!(c["stop"], "noise_floor", "{}", c["stopped_because"]);
-    let named: Vec<String> = c["final_effects"]
+    assert_eq!(v["stop"], "noise_floor", "{}", v["stopped_because"]);
+    let fin = &v["final_fit"];
+    let drift = fin["fitted"]
         .as_array()
         .unwrap()
         .iter()
-        .map(|e| e.as_str().unwrap().to_string())
-        .collect();
+        .find(|e| e["effect"] == "thermal_drift")
+        .unwrap_or_else(|| panic!("no drift named: {:?}", finals(&v)));
+    assert_rise_near(drift, 50.0);
+    let end = fin["ratio_to_floor"].as_f64().unwrap();
+    assert!(end <= band, "the warming log ends at {end:.3}x the floor");
+    let c = ladder_on(&three_hp, false, dir.path());
+    assert_eq!(c["stop"], "noise_floor", "{}", c["stopped_because"]);
+    let named = finals(&c);
     assert!(
         named.iter().all(|e| e.ends_with("_dynamics")),
         "the control names {named:?}"

@@ -440,6 +440,56 @@ pub fn fit_machine_pinned(
     })
 }
 
+/// The six base factors refitted (from `mf`'s) with every effect held at `mf`'s values
+/// corrected for the inputs' noise ([`MachineFit::corrected`]): the machine fit as a model
+/// to predict with, the base moved with the corrected values rather than left where the
+/// biased ones took it; `mf` itself where nothing was corrected. Arguments as
+/// [`fit_machine`]'s.
+///
+/// # Errors
+/// As [`fit_machine`].
+pub fn around_corrected(
+    d: &Prepared,
+    file: &ParamFile,
+    effects: &[ActiveEffect<'_>],
+    w: &Weights,
+    mf: MachineFit,
+    prior_weight: f64,
+    max_iter: usize,
+) -> Result<MachineFit, EffectValuesError> {
+    let Some(values) = mf.corrected.clone() else {
+        return Ok(mf);
+    };
+    let prob = problem(d, file, effects, w, prior_weight);
+    let bs = prob.b_sd / PRIOR_SD[5];
+    let mut x = mf.scales.to_vec();
+    let mut lo: Vec<f64> = FIT_BOUNDS.iter().map(|b| b.0).collect();
+    let mut hi: Vec<f64> = FIT_BOUNDS.iter().map(|b| b.1).collect();
+    lo.push(0.0);
+    hi.push(50.0 * bs);
+    let mut scale = vec![0.05, 0.05, 0.05, 0.05, 0.1, 0.2 * bs];
+    for (q, v) in effects
+        .iter()
+        .flat_map(|e| &e.setup.params)
+        .zip(values.iter().flatten())
+    {
+        x.push(*v);
+        lo.push(q.lo);
+        hi.push(q.hi);
+        scale.push(q.scale);
+    }
+    prob.machine(&x)?;
+    let bounds = lm::Bounds { lo, hi, scale };
+    let free: Vec<usize> = (0..6).collect();
+    let (x, report) = lm::solve(&prob, x, &bounds, &free, max_iter);
+    Ok(MachineFit {
+        scales: MachineScales::from_slice(&x),
+        effect_params: values.clone(),
+        report,
+        corrected: Some(values),
+    })
+}
+
 fn problem<'a>(
     d: &'a Prepared,
     file: &'a ParamFile,

@@ -265,6 +265,17 @@ impl Ladder<'_> {
                 prior_weight(rung.noise),
                 MAX_ITER,
             )?;
+            // Predicted with as the rungs were: at the values corrected for the inputs'
+            // noise, where any were, the base refitted around them.
+            let mf = machine::around_corrected(
+                fdata,
+                &sr.file,
+                set,
+                &w,
+                mf,
+                prior_weight(rung.noise),
+                MAX_ITER,
+            )?;
             if !halves {
                 return Ok((mf, [None; 6]));
             }

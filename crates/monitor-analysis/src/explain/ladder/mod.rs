@@ -17,7 +17,9 @@
 //!    floor, pairs. Every candidate is screened, the finalists fitted in full, the best
 //!    refitted with every value free (`round/fits.rs`); the plausible candidate with the
 //!    lowest held-back error that passes the step's test ([`STEP_MIN`]) and lowers
-//!    the whole-log error is kept, the others refused with why ([`Refusal`]).
+//!    the whole-log error is kept, the others refused with why ([`Refusal`]). A candidate
+//!    whose values the inputs' noise biases is judged at its values corrected for it, the
+//!    base refitted around them, against its own noise floor (`round/choice.rs`).
 //! 4. **Both ways** (`stepwise.rs`): after a step, an earlier effect the model no longer
 //!    needs is dropped (the step explains what it stood in for).
 //! 5. **The stop** (`climb.rs`): within the log's noise-floor band ([`FLOOR_BAND`], narrower

@@ -66,6 +66,14 @@ pub struct FloorBand {
     /// The model error beyond the noise (`sqrt(E² - N²)`) in units of the floor `N`
     /// below which there is nothing left to explain.
     pub excess: f64,
+    /// What each parameter of a candidate costs, as a share of its held-back error:
+    /// [`crate::explain::PARAM_PENALTY`] on a log of up to [`BAND_PERIODS`] supply periods,
+    /// and that times `(x / 0.5)²` beyond, as the band's excess `x` narrows. The penalty
+    /// raises a candidate's squared error by about `2 PARAM_PENALTY` of the floor's square
+    /// a parameter, a margin set against short logs' excess of `0.5² = 0.25`: a 40 s log's
+    /// excess of `0.25² = 0.0625` leaves a three-parameter candidate nothing to win at the
+    /// short logs' rate (`0.12`).
+    pub penalty: f64,
 }
 
 impl FloorBand {
@@ -81,6 +89,7 @@ impl FloorBand {
         FloorBand {
             ratio: FLOOR_BAND * ((1.0 + x * x) / (1.0 + X_SHORT * X_SHORT)).sqrt(),
             excess: x,
+            penalty: crate::explain::PARAM_PENALTY * (x / X_SHORT).powi(2),
         }
     }
 

@@ -202,6 +202,11 @@ impl<'a> Ladder<'a> {
                 continue;
             }
             if let Some(because) = self.cannot_fit(an, e) {
+                // One effect of two laws (the drift's windings apart and together) is
+                // skipped once.
+                if skipped.iter().any(|s: &Skipped| s.effect == e.kind()) {
+                    continue;
+                }
                 skipped.push(Skipped {
                     effect: e.kind(),
                     because,
