@@ -149,7 +149,7 @@ impl ThermalDriftValues {
 const ABOUT: About = About {
     kind: EffectId::THERMAL_DRIFT,
     description: "The windings heat up with load, so the stator and rotor resistances rise (copper: +0.393 %/K; 20 -> 90 C is +27 %); a motor already warm when the log starts is a change of the base parameters, this is the rise on top of it.",
-    equations: "Rs(t), Rr(t) = R (1 + 0.00393 dT(t)), dT(t) = rise_k (1 - exp(-(t - t0)/tau_s)) from the log's start t0; Ra = Rs + (Ls/Lr) Rr in eq. (28) follows; in the full-order model the rotor time constant Lr/Rr follows too. The ladder fits the stator and the rotor apart (stator_rise_k at copper's 0.393 %/K, rotor_rise_k at the cage's aluminium 0.403 %/K).",
+    equations: "Rs(t), Rr(t) = R (1 + 0.00393 dT(t)), dT(t) = rise_k (1 - exp(-(t - t0)/tau_s)) from the log's start t0; Ra = Rs + (Ls/Lr) Rr in eq. (28) follows; in the full-order model the rotor time constant Lr/Rr follows too. The ladder fits this law and the stator and the rotor apart (stator_rise_k at copper's 0.393 %/K, rotor_rise_k at the cage's aluminium 0.403 %/K), and names the one the log tells best.",
     parameters: &PARAMS,
 };
 
