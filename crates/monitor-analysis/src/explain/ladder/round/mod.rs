@@ -267,7 +267,8 @@ fn full_order<'a>(
 /// The pairs a round tries when no single candidate passes: every two of the
 /// [`PAIR_FROM`] single-effect candidates of `fitted` (plausible or not, not
 /// diverged; fits of one round, the model's own `before` effects first in each) that
-/// lowered the training cost most, each pair's effects in the order fitted. A held-back
+/// lowered the training cost most (one law of an effect, its best), each pair's effects in
+/// the order fitted. A held-back
 /// error can rise with one effect of a pair and fall with both: with a start's cross
 /// coupling but no load torque, the fit uses the coupling to follow the acceleration a
 /// missing load explains.
@@ -283,6 +284,14 @@ fn pairs_of<'a>(fitted: &[Fitted<'a>], before: usize) -> Vec<Vec<&'a dyn EffectM
         })
         .collect();
     by_cost.sort_by(|a, b| a.fit.report.cost.total_cmp(&b.fit.report.cost));
+    // One law of an effect with two (the drift's windings apart and together): its best.
+    let mut seen: Vec<EffectId> = Vec::new();
+    by_cost.retain(|c| {
+        let k = c.models.get(before).map(|m| m.kind());
+        let first = k.is_some_and(|k| !seen.contains(&k));
+        seen.extend(k);
+        first
+    });
     let top: Vec<Vec<&'a dyn EffectModel>> = by_cost
         .iter()
         .take(PAIR_FROM)
