@@ -4,7 +4,9 @@ use super::*;
 #[test]
 fn settings_out_of_range_are_named() {
     assert_eq!(Settings::DEFAULT.validate(), Ok(()));
-    for rate in [0, 7_000, 10_050, 3_000_000] {
+    // 0; rates that do not divide the 1 MHz timestamp clock; 3 125 Hz and 40 Hz divide it
+    // (320 and 25 000 ticks) but are no multiple of the 100 Hz status rate.
+    for rate in [0, 7_000, 10_050, 3_000_000, 3_125, 40] {
         let s = Settings {
             sample_rate_hz: rate,
             ..Settings::DEFAULT
@@ -183,7 +185,7 @@ fn an_offset_out_of_bound_flags_its_sensor_in_every_status() {
         0,
         MonitorStatus::default(),
     );
-    let mut flags = |s: &mut Supervisor, k: u32| {
+    let flags = |s: &mut Supervisor, k: u32| {
         let status = MonitorStatus {
             samples: (k + 1) * 500,
             ..MonitorStatus::default()
