@@ -323,6 +323,27 @@ mod tests {
         }
     }
 
+    /// A run that ended in a panic at `line` of `src/app.rs`.
+    fn failed_run(line: u32) -> PreviousRun {
+        let record =
+            crate::reset_record::ResetRecord::panic("index out of bounds", "src/app.rs", line);
+        PreviousRun::Recorded(record)
+    }
+
+    /// The entry numbered `seq` of a run that the watchdog ended in a panic.
+    fn entry(seq: u32) -> Entry {
+        let (ended, record, phase) = Entry::of(&failed_run(seq)).unwrap();
+        Entry {
+            seq,
+            source: ResetSource::IndependentWatchdog,
+            kind: ResetKind::Watchdog,
+            ended,
+            phase,
+            safe_mode: false,
+            record,
+        }
+    }
+
     /// A double word torn at the start of an item (its ECC failing, its bytes not erased)
     /// ends the page there: the page counts as full, its marks before it stay, and the next
     /// item starts the next page, never written over the torn double word.
@@ -363,11 +384,7 @@ mod tests {
             unreadable: None,
         };
         let boot = BootRecord {
-            previous: PreviousRun::Recorded(crate::reset_record::ResetRecord::panic(
-                "index out of bounds",
-                "src/app.rs",
-                7,
-            )),
+            previous: failed_run(7),
             source: ResetSource::IndependentWatchdog,
             kind: ResetKind::Watchdog,
             previous_long_up: false,
@@ -386,5 +403,37 @@ mod tests {
         assert_eq!(s.totals.resets(ResetKind::Watchdog), 1);
         let (entries, n) = newest::<_, 2>(&mut flash);
         assert_eq!((n, entries[0].map(|e| e.seq)), (1, Some(1)));
+    }
+
+    /// Once the log has gone round its pages (the page in use is page 0 again, its oldest
+    /// page the last), the newest entries still come newest first: by their numbers, not
+    /// by the pages' order.
+    #[test]
+    fn after_the_log_goes_round_its_pages_the_newest_come_first() {
+        let mut flash = EccErrorFlash {
+            pages: [[0xFF; PAGE_LEN]; PAGES],
+            unreadable: None,
+        };
+        let full = |page: usize, seq: u32| {
+            let totals = Totals::default();
+            let next_free = PAGE_LEN;
+            Some((
+                page,
+                PageScan {
+                    seq,
+                    totals,
+                    next_free,
+                },
+            ))
+        };
+        append(&mut flash, full(PAGES - 2, 0), &entry(1).encode()).unwrap();
+        let at = locate(&mut flash);
+        assert_eq!(at.map(|(page, _)| page), Some(PAGES - 1));
+        append(&mut flash, at, &entry(2).encode()).unwrap();
+        append(&mut flash, full(PAGES - 1, 1), &entry(3).encode()).unwrap();
+        assert_eq!(locate(&mut flash).map(|(page, _)| page), Some(0));
+        let (entries, n) = newest::<_, 3>(&mut flash);
+        let seqs = entries.map(|e| e.map(|e| e.seq));
+        assert_eq!((n, seqs), (3, [Some(3), Some(2), Some(1)]));
     }
 }
