@@ -4,7 +4,9 @@ use super::*;
 #[test]
 fn settings_out_of_range_are_named() {
     assert_eq!(Settings::DEFAULT.validate(), Ok(()));
-    for rate in [0, 7_000, 10_050, 3_000_000] {
+    // 0; rates that do not divide the 1 MHz timestamp clock; 3 125 Hz and 40 Hz divide it
+    // (320 and 25 000 ticks) but are no multiple of the 100 Hz status rate.
+    for rate in [0, 7_000, 10_050, 3_000_000, 3_125, 40] {
         let s = Settings {
             sample_rate_hz: rate,
             ..Settings::DEFAULT
@@ -162,4 +164,101 @@ fn the_second_candidate_is_the_runner_up_not_the_first_named() {
         let want = (Some((f[top], given[top])), Some((f[second], given[second])));
         assert_eq!(sample_path::candidates(&o), want, "{given:?}");
     }
+}
+
+/// A start-up offset out of bound flags its sensor in every status thread mode takes from
+/// then on (the panel's "input invalid", the status line's `sens=`), the other sensor not;
+/// a second trim with the other sensor out of bound adds it, and a channel in bound clears
+/// nothing (the flag holds until the next boot).
+#[test]
+fn an_offset_out_of_bound_flags_its_sensor_in_every_status() {
+    use crate::offset_trim::{ChannelTrim, TrimKind, TrimResult};
+    let in_bound = ChannelTrim::Trimmed(2047.5);
+    let mut trim = TrimResult {
+        kind: TrimKind::StartUp,
+        voltage: [in_bound; 3],
+        current: [in_bound; 3],
+    };
+    let mut s = Supervisor::new(
+        &Settings::DEFAULT,
+        PreviousRun::Clean,
+        0,
+        MonitorStatus::default(),
+    );
+    let flags = |s: &mut Supervisor, k: u32| {
+        let status = MonitorStatus {
+            samples: (k + 1) * 500,
+            ..MonitorStatus::default()
+        };
+        s.tick(k * PANEL_PERIOD_MS, Some(status), false);
+        let f = s.latest().sensor_fault;
+        (f.voltage, f.current)
+    };
+    s.set_offset_fault(&trim);
+    assert_eq!(flags(&mut s, 0), (false, false));
+    // Voltage b's zero 300 codes from mid-scale: beyond `MAX_OFFSET_CODES` (100).
+    trim.voltage[1] = ChannelTrim::OutOfBound(2347.5);
+    s.set_offset_fault(&trim);
+    assert_eq!(flags(&mut s, 1), (true, false));
+    assert_eq!(flags(&mut s, 2), (true, false));
+    let current_only = TrimResult {
+        current: [in_bound, in_bound, ChannelTrim::OutOfBound(1700.0)],
+        voltage: [in_bound; 3],
+        ..trim
+    };
+    s.set_offset_fault(&current_only);
+    assert_eq!(flags(&mut s, 3), (true, true));
+}
+
+/// After a failed run the panel shows "monitor failed" for [`FAILED_BOOT_SHOW_MS`] (5 s)
+/// from the boot and ends the show at the first tick at or after that, whatever the ticks'
+/// phase against the boot and across the millisecond clock's wrap.
+#[test]
+fn the_failed_boots_show_ends_at_the_first_tick_after_five_seconds() {
+    for boot_ms in [0u32, 3, u32::MAX - 1_000] {
+        let mut s = Supervisor::new(
+            &Settings::DEFAULT,
+            PreviousRun::WatchdogReset { phase: None },
+            boot_ms,
+            MonitorStatus::default(),
+        );
+        for k in 0..200u32 {
+            // Ticks 20 ms out of phase with the boot: none falls on 5 000 ms exactly.
+            let since_boot = 20 + k * PANEL_PERIOD_MS;
+            let status = MonitorStatus {
+                samples: (k + 1) * 500,
+                ..MonitorStatus::default()
+            };
+            let mode = s
+                .tick(boot_ms.wrapping_add(since_boot), Some(status), false)
+                .mode;
+            let showing = since_boot < FAILED_BOOT_SHOW_MS;
+            assert_eq!(mode == Mode::Failed, showing, "{boot_ms} + {since_boot} ms");
+        }
+    }
+}
+
+/// The VDDA of the record loaded at boot goes into force for the reference's correction:
+/// the supervisor's correction holds it, and a later VDDA 2 % lower (in band) puts a gain
+/// of 0.98 into force.
+#[test]
+fn the_records_vdda_goes_into_force_for_the_correction() {
+    let mut record = CalibrationRecord::from(monitor_core::Calibration::default());
+    record.vdda_v = Some(3.3);
+    let mut s = Supervisor::new(
+        &Settings::DEFAULT,
+        PreviousRun::Clean,
+        0,
+        MonitorStatus::default(),
+    );
+    s.restore_reference(&record);
+    assert_eq!(s.reference_correction().commissioned_v(), Some(3.3));
+    s.observe_reference(crate::board::ReferenceCheck::InBand(3.234), 0);
+    let status = MonitorStatus {
+        samples: 500,
+        ..MonitorStatus::default()
+    };
+    let gain = s.tick(PANEL_PERIOD_MS, Some(status), false).reference_gain;
+    assert!(gain.is_some_and(|g| (g - 0.98).abs() < 1e-4), "{gain:?}");
+    assert!((s.reference_correction().in_force() - 0.98).abs() < 1e-4);
 }

@@ -24,6 +24,16 @@ fn code_of_inverts_apply_within_half_lsb() {
     }
     assert_eq!(v.code_of(1e6), ADC_MAX_CODE);
     assert_eq!(v.code_of(-1e6), 0);
+    // No code for a value that is not finite, nor through a scale of no gain: the zero's
+    // code, 2047 (mid-scale's 2047.5 truncated), not a rail.
+    for x in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        assert_eq!(v.code_of(x), 2047, "{x}");
+    }
+    let dead = ChannelScale {
+        per_lsb: 0.0,
+        ..ChannelScale::CURRENT
+    };
+    assert_eq!((dead.code_of(5.0), dead.code_of(-5.0)), (2047, 2047));
     assert!(is_saturated_code(0) && is_saturated_code(4095) && !is_saturated_code(1));
 }
 

@@ -37,6 +37,12 @@ fn a_load_step_with_no_fault_is_the_moved_state_not_a_fault() {
         bl_scale: Some(1.3),
     }];
     let rig = commissioned_then(&scenario);
+    // The supervisor hands out the range the run learned (the one "moved" is judged on).
+    assert!(
+        rig.supervisor.range().commissioned().is_learned(),
+        "no commissioned range: {:?}",
+        rig.supervisor.range()
+    );
     let before: Vec<&Seen> = rig
         .seen
         .iter()

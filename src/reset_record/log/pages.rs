@@ -287,3 +287,153 @@ pub fn newest<F: LogFlash, const N: usize>(flash: &mut F) -> ([Option<Entry>; N]
     let n = out.iter().filter(|e| e.is_some()).count();
     (out, n)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The log's pages, the reads of one double word failing (an ECC double error).
+    struct EccErrorFlash {
+        pages: [[u8; PAGE_LEN]; PAGES],
+        unreadable: Option<(usize, usize)>,
+    }
+
+    impl LogFlash for EccErrorFlash {
+        type Error = ();
+        fn read(&mut self, page: usize, offset: usize, buf: &mut [u8]) -> Result<(), ()> {
+            let hit =
+                |(p, o): (usize, usize)| p == page && (offset..offset + buf.len()).contains(&o);
+            if self.unreadable.is_some_and(hit) {
+                return Err(());
+            }
+            buf.copy_from_slice(&self.pages[page][offset..offset + buf.len()]);
+            Ok(())
+        }
+        fn erase(&mut self, page: usize) -> Result<(), ()> {
+            self.pages[page] = [0xFF; PAGE_LEN];
+            Ok(())
+        }
+        fn write(&mut self, page: usize, offset: usize, bytes: &[u8]) -> Result<(), ()> {
+            let at = &mut self.pages[page][offset..offset + bytes.len()];
+            // Flash is written only where erased (RM0440: programming a double word not
+            // erased is an error).
+            assert!(at.iter().all(|b| *b == 0xFF), "written over {offset}");
+            at.copy_from_slice(bytes);
+            Ok(())
+        }
+    }
+
+    /// A run that ended in a panic at `line` of `src/app.rs`.
+    fn failed_run(line: u32) -> PreviousRun {
+        let record =
+            crate::reset_record::ResetRecord::panic("index out of bounds", "src/app.rs", line);
+        PreviousRun::Recorded(record)
+    }
+
+    /// The entry numbered `seq` of a run that the watchdog ended in a panic.
+    fn entry(seq: u32) -> Entry {
+        let (ended, record, phase) = Entry::of(&failed_run(seq)).unwrap();
+        Entry {
+            seq,
+            source: ResetSource::IndependentWatchdog,
+            kind: ResetKind::Watchdog,
+            ended,
+            phase,
+            safe_mode: false,
+            record,
+        }
+    }
+
+    /// A double word torn at the start of an item (its ECC failing, its bytes not erased)
+    /// ends the page there: the page counts as full, its marks before it stay, and the next
+    /// item starts the next page, never written over the torn double word.
+    #[test]
+    fn a_torn_double_word_at_an_items_start_ends_its_page() {
+        let mut flash = EccErrorFlash {
+            pages: [[0xFF; PAGE_LEN]; PAGES],
+            unreadable: None,
+        };
+        let mark = Mark {
+            what: ResetKind::Pin.index(),
+            count: 1,
+            failed: false,
+            safe_mode: false,
+        };
+        append(&mut flash, None, &mark.encode()).unwrap();
+        let torn = HEADER_LEN + MARK_LEN;
+        flash.pages[0][torn..torn + MARK_LEN]
+            .copy_from_slice(&[0x43, 0x02, 0, 0, 0, 0, 0xFF, 0xFF]);
+        flash.unreadable = Some((0, torn));
+        let (page, s) = locate(&mut flash).unwrap();
+        assert_eq!(
+            (page, s.next_free, s.totals.resets(ResetKind::Pin)),
+            (0, PAGE_LEN, 1)
+        );
+        append(&mut flash, Some((page, s)), &mark.encode()).unwrap();
+        let (page, s) = locate(&mut flash).unwrap();
+        assert_eq!((page, s.next_free), (1, HEADER_LEN + MARK_LEN));
+        assert_eq!(s.totals.resets(ResetKind::Pin), 2);
+    }
+
+    /// An entry that ends where an unreadable double word begins is read whole: counted,
+    /// and the newest entry; the page is full from the torn double word on.
+    #[test]
+    fn an_entry_just_before_a_torn_double_word_is_kept() {
+        let mut flash = EccErrorFlash {
+            pages: [[0xFF; PAGE_LEN]; PAGES],
+            unreadable: None,
+        };
+        let boot = BootRecord {
+            previous: failed_run(7),
+            source: ResetSource::IndependentWatchdog,
+            kind: ResetKind::Watchdog,
+            previous_long_up: false,
+            previous_up: false,
+            ram_kept: false,
+            safe_mode: false,
+        };
+        let mut pending = Pending::EMPTY;
+        let written = record_boot(&mut flash, &boot, &mut pending).unwrap();
+        assert_eq!(written, Written::Entry(1));
+        let torn = HEADER_LEN + ENTRY_LEN;
+        flash.pages[0][torn] = 0x43;
+        flash.unreadable = Some((0, torn));
+        let (page, s) = locate(&mut flash).unwrap();
+        assert_eq!((page, s.next_free), (0, PAGE_LEN));
+        assert_eq!(s.totals.resets(ResetKind::Watchdog), 1);
+        let (entries, n) = newest::<_, 2>(&mut flash);
+        assert_eq!((n, entries[0].map(|e| e.seq)), (1, Some(1)));
+    }
+
+    /// Once the log has gone round its pages (the page in use is page 0 again, its oldest
+    /// page the last), the newest entries still come newest first: by their numbers, not
+    /// by the pages' order.
+    #[test]
+    fn after_the_log_goes_round_its_pages_the_newest_come_first() {
+        let mut flash = EccErrorFlash {
+            pages: [[0xFF; PAGE_LEN]; PAGES],
+            unreadable: None,
+        };
+        let full = |page: usize, seq: u32| {
+            let totals = Totals::default();
+            let next_free = PAGE_LEN;
+            Some((
+                page,
+                PageScan {
+                    seq,
+                    totals,
+                    next_free,
+                },
+            ))
+        };
+        append(&mut flash, full(PAGES - 2, 0), &entry(1).encode()).unwrap();
+        let at = locate(&mut flash);
+        assert_eq!(at.map(|(page, _)| page), Some(PAGES - 1));
+        append(&mut flash, at, &entry(2).encode()).unwrap();
+        append(&mut flash, full(PAGES - 1, 1), &entry(3).encode()).unwrap();
+        assert_eq!(locate(&mut flash).map(|(page, _)| page), Some(0));
+        let (entries, n) = newest::<_, 3>(&mut flash);
+        let seqs = entries.map(|e| e.map(|e| e.seq));
+        assert_eq!((n, seqs), (3, [Some(3), Some(2), Some(1)]));
+    }
+}
