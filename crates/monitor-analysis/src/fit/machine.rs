@@ -403,26 +403,18 @@ pub fn fit_machine_pinned(
     pin: Option<BaseKey>,
 ) -> Result<MachineFit, EffectValuesError> {
     let prob = problem(d, file, effects, w, prior_weight);
-    let bs = prob.b_sd / PRIOR_SD[5];
-    let mut x = start.to_vec();
-    let mut lo: Vec<f64> = FIT_BOUNDS.iter().map(|b| b.0).collect();
-    let mut hi: Vec<f64> = FIT_BOUNDS.iter().map(|b| b.1).collect();
-    lo.push(0.0);
-    hi.push(50.0 * bs);
-    let mut scale = vec![0.05, 0.05, 0.05, 0.05, 0.1, 0.2 * bs];
-    for q in effects.iter().flat_map(|e| &e.setup.params) {
-        x.push(q.init);
-        lo.push(q.lo);
-        hi.push(q.hi);
-        scale.push(q.scale);
-    }
+    let inits: Vec<f64> = effects
+        .iter()
+        .flat_map(|e| &e.setup.params)
+        .map(|q| q.init)
+        .collect();
+    let (mut x, bounds) = start_and_bounds(&prob, start, effects, &inits);
     if let Some(k) = pin {
         x[k.index()] = MachineScales::of_file(file).get(k);
     }
     prob.machine(&x)?;
     let mut free = prob.free(x.len());
     free.retain(|&i| pin.is_none_or(|k| i != k.index()));
-    let bounds = lm::Bounds { lo, hi, scale };
     let (x, report) = lm::solve(&prob, x, &bounds, &free, max_iter);
     let renoised = |nz| MachineProblem {
         extra_noise: Some(nz),
@@ -440,14 +432,9 @@ pub fn fit_machine_pinned(
     })
 }
 
-/// The six base factors refitted (from `mf`'s) with every effect held at `mf`'s values
-/// corrected for the inputs' noise ([`MachineFit::corrected`]): the machine fit as a model
-/// to predict with, the base moved with the corrected values rather than left where the
-/// biased ones took it; `mf` itself where nothing was corrected. Arguments as
-/// [`fit_machine`]'s.
-///
-/// # Errors
-/// As [`fit_machine`].
+/// The six base factors refitted (from `mf`'s) around the effects held at `mf`'s values
+/// corrected for the inputs' noise ([`MachineFit::corrected`]), to predict with; `mf`
+/// itself where nothing was corrected. Arguments and errors as [`fit_machine`]'s.
 pub fn around_corrected(
     d: &Prepared,
     file: &ParamFile,
@@ -461,25 +448,9 @@ pub fn around_corrected(
         return Ok(mf);
     };
     let prob = problem(d, file, effects, w, prior_weight);
-    let bs = prob.b_sd / PRIOR_SD[5];
-    let mut x = mf.scales.to_vec();
-    let mut lo: Vec<f64> = FIT_BOUNDS.iter().map(|b| b.0).collect();
-    let mut hi: Vec<f64> = FIT_BOUNDS.iter().map(|b| b.1).collect();
-    lo.push(0.0);
-    hi.push(50.0 * bs);
-    let mut scale = vec![0.05, 0.05, 0.05, 0.05, 0.1, 0.2 * bs];
-    for (q, v) in effects
-        .iter()
-        .flat_map(|e| &e.setup.params)
-        .zip(values.iter().flatten())
-    {
-        x.push(*v);
-        lo.push(q.lo);
-        hi.push(q.hi);
-        scale.push(q.scale);
-    }
+    let flat: Vec<f64> = values.iter().flatten().copied().collect();
+    let (x, bounds) = start_and_bounds(&prob, &mf.scales, effects, &flat);
     prob.machine(&x)?;
-    let bounds = lm::Bounds { lo, hi, scale };
     let free: Vec<usize> = (0..6).collect();
     let (x, report) = lm::solve(&prob, x, &bounds, &free, max_iter);
     Ok(MachineFit {
@@ -488,6 +459,30 @@ pub fn around_corrected(
         report,
         corrected: Some(values),
     })
+}
+
+/// The machine fit's start (the factors `start`, then the effects' `values`) and bounds:
+/// [`FIT_BOUNDS`], B + Bl up to 50 prior deviations, each effect value's its set-up's.
+fn start_and_bounds(
+    prob: &MachineProblem<'_>,
+    start: &MachineScales,
+    effects: &[ActiveEffect<'_>],
+    values: &[f64],
+) -> (Vec<f64>, lm::Bounds) {
+    let bs = prob.b_sd / PRIOR_SD[5];
+    let mut x = start.to_vec();
+    let mut lo: Vec<f64> = FIT_BOUNDS.iter().map(|b| b.0).collect();
+    let mut hi: Vec<f64> = FIT_BOUNDS.iter().map(|b| b.1).collect();
+    lo.push(0.0);
+    hi.push(50.0 * bs);
+    let mut scale = vec![0.05, 0.05, 0.05, 0.05, 0.1, 0.2 * bs];
+    for (q, v) in effects.iter().flat_map(|e| &e.setup.params).zip(values) {
+        x.push(*v);
+        lo.push(q.lo);
+        hi.push(q.hi);
+        scale.push(q.scale);
+    }
+    (x, lm::Bounds { lo, hi, scale })
 }
 
 fn problem<'a>(
