@@ -113,16 +113,15 @@ impl ClockSource {
 }
 /// `RCC_PLLCFGR` for the PLL from `source` (RM0440, "PLL configuration register"), as
 /// embassy-stm32's `init` writes it from the firmware's clock configuration: `PLLSRC`
-/// (bits 1:0; 2 the HSI16, 3 the HSE), `PLLM - 1` (bits 7:4), `PLLN` (bits 14:8), `PLLREN`
-/// (bit 24) and `PLLR` = /2 (bits 26:25, `PLLR / 2 - 1`); the P and Q outputs off. The boot
-/// writes it for the PLL's bounded lock before `init` (`crate::startup::pll_locks`).
+/// (bits 1:0; 2 the HSI16, 3 the HSE) and the source's [`pll_fields`] ([`PllFields::cfgr`]).
+/// The boot writes it for the PLL's bounded lock before `init`
+/// (`crate::startup::pll_locks`).
 pub const fn pll_cfgr(source: ClockSource) -> u32 {
     let src = match source {
         ClockSource::Hse => 3,
         ClockSource::Hsi | ClockSource::HsiAfterFailure => 2,
     };
-    let f = pll_fields(source);
-    src | ((f.m as u32) << 4) | ((f.n as u32) << 8) | (1 << 24) | ((f.r as u32) << 25)
+    pll_fields(source).cfgr(src)
 }
 
 /// The PLL's dividers and multiplier as `RCC_PLLCFGR`'s fields encode them (RM0440):
@@ -136,6 +135,19 @@ pub struct PllFields {
     pub n: u8,
     /// `PLLR`: the R output's divider, `R / 2 - 1` (0: /2, 1: /4, 2: /6, 3: /8).
     pub r: u8,
+}
+
+impl PllFields {
+    /// `RCC_PLLCFGR` with these fields and the source selection `pllsrc` (bits 1:0), as
+    /// RM0440 lays the register out: `PLLM` (bits 7:4), `PLLN` (bits 14:8), `PLLREN` (bit
+    /// 24: the R output, SYSCLK's, on) and `PLLR` (bits 26:25); the P and Q outputs off.
+    pub const fn cfgr(self, pllsrc: u32) -> u32 {
+        pllsrc
+            | ((self.m as u32) << 4)
+            | ((self.n as u32) << 8)
+            | (1 << 24)
+            | ((self.r as u32) << 25)
+    }
 }
 
 /// The PLL's fields from `source` ([`PllFields`]).
@@ -167,37 +179,46 @@ pub const TIMER_HZ: u32 = SYSCLK_HZ;
 pub const ADC_CLOCK_DIV: u32 = adc_clock_divider(SYSCLK_HZ);
 
 /// The smallest divider of `ADC12_CCR.PRESC` that brings `kernel_hz` within
-/// [`ADC_CLOCK_MAX_HZ`] (256 when none does).
+/// [`ADC_CLOCK_MAX_HZ`] (256 when none does; the quotient rounded up, so that a kernel clock
+/// a few hertz above a multiple of the limit is not taken as within it).
 pub const fn adc_clock_divider(kernel_hz: u32) -> u32 {
     const DIVIDERS: [u32; 12] = [1, 2, 4, 6, 8, 10, 12, 16, 32, 64, 128, 256];
     let mut rest: &[u32] = &DIVIDERS;
     while let [div, tail @ ..] = rest {
-        if kernel_hz / *div <= ADC_CLOCK_MAX_HZ {
+        if kernel_hz.div_ceil(*div) <= ADC_CLOCK_MAX_HZ {
             return *div;
         }
         rest = tail;
     }
     256
 }
-/// `ADC12_CCR.PRESC`'s encoding of [`ADC_CLOCK_DIV`] (RM0440: 0 /1, 1 /2, 2 /4, 3 /6, 4 /8,
-/// 5 /10, 6 /12, 7 /16, 8 /32, 9 /64, 10 /128, 11 /256; 0xFF for a divider it has not):
-/// embassy-stm32 0.6 picks the divider itself in `Adc::new`; the firmware reads the field
-/// back after the set-up (`adc_rules::create_pair`) and reports a difference.
-pub const ADC_PRESC: u32 = match ADC_CLOCK_DIV {
-    1 => 0,
-    2 => 1,
-    4 => 2,
-    6 => 3,
-    8 => 4,
-    10 => 5,
-    12 => 6,
-    16 => 7,
-    32 => 8,
-    64 => 9,
-    128 => 10,
-    256 => 11,
-    _ => 0xFF,
+/// `ADC12_CCR.PRESC`'s encoding of [`ADC_CLOCK_DIV`] ([`adc_presc`]): embassy-stm32 0.6
+/// picks the divider itself in `Adc::new`; the firmware reads the field back after the
+/// set-up (`adc_rules::create_pair`) and reports a difference.
+pub const ADC_PRESC: u32 = match adc_presc(ADC_CLOCK_DIV) {
+    Some(presc) => presc,
+    None => panic!("the ADC clock's divider has no encoding in ADC12_CCR.PRESC"),
 };
+
+/// `ADC12_CCR.PRESC`'s encoding of the divider `div` (RM0440: 0 /1, 1 /2, 2 /4, 3 /6, 4 /8,
+/// 5 /10, 6 /12, 7 /16, 8 /32, 9 /64, 10 /128, 11 /256); `None` for a divider it has not.
+pub const fn adc_presc(div: u32) -> Option<u32> {
+    match div {
+        1 => Some(0),
+        2 => Some(1),
+        4 => Some(2),
+        6 => Some(3),
+        8 => Some(4),
+        10 => Some(5),
+        12 => Some(6),
+        16 => Some(7),
+        32 => Some(8),
+        64 => Some(9),
+        128 => Some(10),
+        256 => Some(11),
+        _ => None,
+    }
+}
 /// The ADC clock [Hz]: 42.5 MHz.
 pub const ADC_CLOCK_HZ: u32 = SYSCLK_HZ / ADC_CLOCK_DIV;
 
@@ -269,6 +290,72 @@ mod tests {
         let hse = PllFields { m: 5, n: 85, r: 0 };
         assert_eq!(pll_fields(ClockSource::Hse), hse);
         assert_eq!(pll_fields(ClockSource::Hsi), PllFields { m: 3, ..hse });
+    }
+
+    /// `ADC12_CCR.PRESC`'s table in RM0440 ("ADC common control register"): each of the
+    /// twelve dividers its code, nothing for a divider the field has not.
+    #[test]
+    fn every_adc_divider_has_rm0440s_presc_code() {
+        let rm0440 = [
+            (1, 0b0000),
+            (2, 0b0001),
+            (4, 0b0010),
+            (6, 0b0011),
+            (8, 0b0100),
+            (10, 0b0101),
+            (12, 0b0110),
+            (16, 0b0111),
+            (32, 0b1000),
+            (64, 0b1001),
+            (128, 0b1010),
+            (256, 0b1011),
+        ];
+        for (div, code) in rm0440 {
+            assert_eq!(adc_presc(div), Some(code), "/{div}");
+        }
+        for div in [0, 3, 5, 7, 9, 14, 24, 48, 100, 255, 512] {
+            assert_eq!(adc_presc(div), None, "/{div}");
+        }
+    }
+
+    /// The smallest divider that keeps the ADC clock at or below 60 MHz: a kernel clock at
+    /// the limit undivided, one hertz above it halved, and so on along the field's
+    /// dividers; above 15.36 GHz none would do (not reachable with a `u32`).
+    #[test]
+    fn the_adc_divider_is_the_smallest_within_60_mhz() {
+        let cases = [
+            (16_000_000, 1),
+            (60_000_000, 1),
+            (60_000_001, 2),
+            (120_000_000, 2),
+            (120_000_001, 4),
+            (170_000_000, 4),
+            (240_000_000, 4),
+            (240_000_001, 6),
+            (360_000_001, 8),
+            (u32::MAX, 128),
+        ];
+        for (kernel_hz, div) in cases {
+            assert_eq!(adc_clock_divider(kernel_hz), div, "{kernel_hz} Hz");
+            assert!(adc_presc(div).is_some(), "/{div}");
+        }
+    }
+
+    /// `RCC_PLLCFGR`'s fields where RM0440 puts them, each at its largest value: `PLLSRC`
+    /// 1:0, `PLLM` 7:4, `PLLN` 14:8, `PLLREN` 24 and `PLLR` 26:25; `PLLR` = 1 (/4) alone at
+    /// bit 25.
+    #[test]
+    fn the_pll_fields_are_where_rm0440_puts_them() {
+        let widest = PllFields {
+            m: 15,
+            n: 127,
+            r: 3,
+        };
+        assert_eq!(widest.cfgr(3), 0x0700_7FF3);
+        let by_four = PllFields { m: 0, n: 0, r: 1 };
+        assert_eq!(by_four.cfgr(0), 0x0300_0000);
+        let by_two = PllFields { m: 0, n: 0, r: 0 };
+        assert_eq!(by_two.cfgr(0), 0x0100_0000);
     }
 
     /// The time base's error by source: the crystal's 50 ppm (the assumption above), the
