@@ -2,8 +2,7 @@
 //!
 //! The problem ([`LeastSquares`]) gives residuals; the solver minimises half their sum of
 //! squares over the free parameters, with box bounds enforced by clamping each trial step,
-//! a forward-difference Jacobian computed in parallel (rayon) every [`JACOBIAN_EVERY`]
-//! iterations and Broyden's secant update of it in between, Marquardt's diagonal
+//! a forward-difference Jacobian computed in parallel (rayon), Marquardt's diagonal
 //! scaling, and reports how it ended ([`Report`]). Priors are the problem's business: they
 //! are residuals like any other. (The `levenberg-marquardt` crate has no bounds and
 //! argmin's LM neither; clamping to the physical bounds is what the fits here need, so the
@@ -95,14 +94,6 @@ pub const FLAT_TOL: f64 = 1e-4;
 pub const FLAT_ITERATIONS: usize = 5;
 /// Damping increases tried per iteration before the solve counts as stalled.
 pub const DAMPING_TRIES: usize = 8;
-/// Iterations a finite-difference Jacobian serves: the first with it as computed, the
-/// others with Broyden's rank-one update along each accepted step (the secant version of
-/// Levenberg-Marquardt: K. Madsen, H. B. Nielsen, O. Tingleff, *Methods for non-linear
-/// least squares problems*, 2nd ed., IMM DTU 2004, section 3.4). A column costs one run of
-/// the model, an update none; an iteration whose updated Jacobian finds no step that lowers
-/// the cost is run again with a fresh one, so the solve stalls only where the finite
-/// differences do.
-pub const JACOBIAN_EVERY: usize = 2;
 
 /// Half the sum of squares.
 pub fn cost_of(r: &[f64]) -> f64 {
@@ -117,18 +108,6 @@ pub fn solve<P: LeastSquares>(
     b: &Bounds,
     free: &[usize],
     max_iter: usize,
-) -> (Vec<f64>, Report) {
-    solve_every(prob, x, b, free, max_iter, JACOBIAN_EVERY)
-}
-
-/// [`solve`] with a finite-difference Jacobian every `every` iterations (1: at each).
-fn solve_every<P: LeastSquares>(
-    prob: &P,
-    x: Vec<f64>,
-    b: &Bounds,
-    free: &[usize],
-    max_iter: usize,
-    every: usize,
 ) -> (Vec<f64>, Report) {
     let mut p = Point::at(prob, x);
     let mut report = Report {
@@ -145,30 +124,14 @@ fn solve_every<P: LeastSquares>(
     // Cost after each iteration, for the slow-progress rule.
     let mut history: Vec<f64> = Vec::with_capacity(max_iter + 1);
     history.push(p.cost);
-    // The Jacobian's columns and how many iterations they have served.
-    let mut jac: Option<(Vec<Vec<f64>>, usize)> = None;
     for it in 0..max_iter {
         report.iterations = it + 1;
-        let (mut cols, mut age) = match jac.take() {
-            Some((c, age)) if age < every => (c, age),
-            _ => (jacobian_columns(prob, &p.x, &p.r, &p.cache, b, free), 0),
-        };
-        let (x_before, r_before, lambda_before) = (p.x.clone(), p.r.clone(), lambda);
-        let mut step = damped_step(prob, &mut p, &mut lambda, b, free, &cols);
-        if step.is_none() && age > 0 {
-            // The updated Jacobian found no step: again with a fresh one, from the damping
-            // the iteration began with.
-            cols = jacobian_columns(prob, &p.x, &p.r, &p.cache, b, free);
-            (age, lambda) = (0, lambda_before);
-            step = damped_step(prob, &mut p, &mut lambda, b, free, &cols);
-        }
+        let step = damped_step(prob, &mut p, &mut lambda, b, free);
         report.cost = p.cost;
         let Some(rel) = step else {
             report.termination = Termination::Stalled;
             break;
         };
-        broyden(&mut cols, free, b, &x_before, &p.x, &r_before, &p.r);
-        jac = Some((cols, age + 1));
         small_steps = if rel < REL_TOL { small_steps + 1 } else { 0 };
         if small_steps >= 2 {
             report.termination = Termination::Converged;
@@ -181,40 +144,6 @@ fn solve_every<P: LeastSquares>(
         }
     }
     (p.x, report)
-}
-
-/// Broyden's rank-one update of the Jacobian's columns `cols` (in `free`'s order) along
-/// the step from `x0` (residuals `r0`) to `x1` (`r1`): the least change, in the parameters'
-/// typical magnitudes (`b.scale`), after which the Jacobian maps the step onto the
-/// residuals' change, `J s = r1 - r0`.
-fn broyden(
-    cols: &mut [Vec<f64>],
-    free: &[usize],
-    b: &Bounds,
-    x0: &[f64],
-    x1: &[f64],
-    r0: &[f64],
-    r1: &[f64],
-) {
-    let s: Vec<f64> = free.iter().map(|&i| x1[i] - x0[i]).collect();
-    let scale: Vec<f64> = free.iter().map(|&i| b.scale[i].abs().max(1e-300)).collect();
-    let ss: f64 = s.iter().zip(&scale).map(|(s, c)| (s / c) * (s / c)).sum();
-    if !(ss > 0.0 && ss.is_finite()) {
-        return;
-    }
-    // u = (r1 - r0) - J s.
-    let mut u: Vec<f64> = r1.iter().zip(r0).map(|(a, b)| a - b).collect();
-    for (col, sa) in cols.iter().zip(&s) {
-        for (u, j) in u.iter_mut().zip(col) {
-            *u -= j * sa;
-        }
-    }
-    for ((col, sa), c) in cols.iter_mut().zip(&s).zip(&scale) {
-        let w = sa / (c * c) / ss;
-        for (j, u) in col.iter_mut().zip(&u) {
-            *j += u * w;
-        }
-    }
 }
 
 /// The solver's point: the parameters, their residuals, the residuals' cache and the cost.
@@ -239,8 +168,8 @@ impl<C> Point<C> {
     }
 }
 
-/// One iteration: the normal equations at `p` of the Jacobian's columns `cols`, then
-/// Marquardt's step tried with the damping `lambda` raised (x10 when the damped matrix is not positive definite, x8 when
+/// One iteration: the normal equations at `p`, then Marquardt's step tried with the
+/// damping `lambda` raised (x10 when the damped matrix is not positive definite, x8 when
 /// the step does not lower the cost) up to [`DAMPING_TRIES`] times. The first step that
 /// lowers the cost is taken (`p` moves there, the damping falls by 3) and its relative
 /// decrease returned; `None` when none did.
@@ -250,9 +179,8 @@ fn damped_step<P: LeastSquares>(
     lambda: &mut f64,
     b: &Bounds,
     free: &[usize],
-    cols: &[Vec<f64>],
 ) -> Option<f64> {
-    let (jtj, jtr) = normal_matrix(cols, &p.r);
+    let (jtj, jtr) = normal_equations(prob, &p.x, &p.r, &p.cache, b, free);
     let m = free.len();
     for _ in 0..DAMPING_TRIES {
         let mut aug = jtj.clone();
@@ -307,12 +235,8 @@ pub fn normal_equations<P: LeastSquares>(
     b: &Bounds,
     free: &[usize],
 ) -> (DMatrix<f64>, DVector<f64>) {
-    normal_matrix(&jacobian_columns(prob, x, r, cache, b, free), r)
-}
-
-/// `J^T J` and `J^T r` of the Jacobian's columns `cols` and the residuals `r`.
-fn normal_matrix(cols: &[Vec<f64>], r: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
-    let m = cols.len();
+    let cols = jacobian_columns(prob, x, r, cache, b, free);
+    let m = free.len();
     let mut jtj = DMatrix::<f64>::zeros(m, m);
     let mut jtr = DVector::<f64>::zeros(m);
     for a in 0..m {
@@ -425,85 +349,6 @@ mod tests {
             1.0 - 5e-6,
         ];
         assert!(slow_progress(&late));
-    }
-
-    /// Broyden's update leaves a Jacobian that maps the step onto the residuals' change
-    /// (the secant condition), whatever the parameters' scales.
-    #[test]
-    fn the_secant_update_maps_the_step_onto_the_change() {
-        let b = Bounds {
-            lo: vec![-10.0; 3],
-            hi: vec![10.0; 3],
-            scale: vec![1e-3, 1.0, 50.0],
-        };
-        let mut cols = vec![vec![1.0, 2.0, 3.0, 4.0], vec![0.5, -1.0, 0.0, 2.0]];
-        let free = [0, 2];
-        let (x0, x1) = ([0.1, 7.0, 2.0], [0.1003, 7.0, 1.5]);
-        let (r0, r1) = ([1.0, 1.0, 1.0, 1.0], [0.7, 1.4, 0.2, -3.0]);
-        broyden(&mut cols, &free, &b, &x0, &x1, &r0, &r1);
-        for row in 0..4 {
-            let js = cols[0][row] * (x1[0] - x0[0]) + cols[1][row] * (x1[2] - x0[2]);
-            let dr = r1[row] - r0[row];
-            assert!(
-                (js - dr).abs() < 1e-12 * (1.0 + dr.abs()),
-                "row {row}: {js} vs {dr}"
-            );
-        }
-        // A zero step leaves the columns as they were.
-        let before = cols.clone();
-        broyden(&mut cols, &free, &b, &x1, &x1, &r1, &r0);
-        assert_eq!(cols, before);
-    }
-
-    /// Residual evaluations of a problem, counted.
-    struct Counted<'a>(
-        std::sync::atomic::AtomicUsize,
-        &'a (dyn Fn(&[f64]) -> Vec<f64> + Sync),
-    );
-    impl LeastSquares for Counted<'_> {
-        type Cache = ();
-        fn cache(&self, _x: &[f64]) {}
-        fn residuals(&self, x: &[f64], _c: &()) -> Vec<f64> {
-            self.0.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            (self.1)(x)
-        }
-    }
-
-    /// The secant iterations save model runs: on a mildly nonlinear fit of four parameters
-    /// (an exponential's amplitude, rate, offset and slope on 50 points) the solve reaches
-    /// the same minimum with fewer residual evaluations than with a finite-difference
-    /// Jacobian at every iteration.
-    #[test]
-    fn the_secant_iterations_reach_the_minimum_with_fewer_runs() {
-        let truth = [2.0, 0.8, 0.5, -0.1];
-        let model = |p: &[f64], t: f64| p[0] * (-p[1] * t).exp() + p[2] + p[3] * t;
-        let ts: Vec<f64> = (0..50).map(|i| i as f64 * 0.1).collect();
-        let data: Vec<f64> = ts.iter().map(|&t| model(&truth, t)).collect();
-        let res = |p: &[f64]| -> Vec<f64> {
-            ts.iter()
-                .zip(&data)
-                .map(|(&t, y)| model(p, t) - y)
-                .collect()
-        };
-        let b = Bounds {
-            lo: vec![-10.0; 4],
-            hi: vec![10.0; 4],
-            scale: vec![1.0; 4],
-        };
-        let runs = |every: usize| {
-            let prob = Counted(std::sync::atomic::AtomicUsize::new(0), &res);
-            let start = vec![1.0, 0.3, 0.0, 0.0];
-            let (x, rep) = solve_every(&prob, start, &b, &[0, 1, 2, 3], 100, every);
-            for (a, t) in x.iter().zip(truth) {
-                assert!((a - t).abs() < 1e-5, "every {every}: {x:?} {rep:?}");
-            }
-            prob.0.load(std::sync::atomic::Ordering::Relaxed)
-        };
-        let (secant, each) = (runs(JACOBIAN_EVERY), runs(1));
-        assert!(
-            secant < each,
-            "{secant} runs with the secant update, {each} without"
-        );
     }
 
     #[test]

@@ -174,28 +174,7 @@ impl FullMachine {
         k: usize,
         mf: f64,
     ) -> Self {
-        MachineParts::of(n, b, t, mf).at(t, k)
-    }
-}
-
-/// What of [`FullMachine`] no per-sample resistance scale changes, computed once for a run
-/// whose Lm does not change from sample to sample (a model run takes a machine at each of
-/// its samples; the inductances and their divisions were a twentieth of its time). The
-/// machine at a sample ([`MachineParts::at`]) is the same to the bit as computed whole.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct MachineParts {
-    /// Rs times the refitted Ra scale [ohm] (the sample's scales multiply it).
-    rs: f64,
-    /// `a` = `a_num` rf / `a_den` (rf the sample's resistance scale).
-    a_num: f64,
-    a_den: f64,
-    l_sigma: f64,
-    l_m: f64,
-}
-
-impl MachineParts {
-    /// The parts with the magnetising inductance `mf` x Lm.
-    fn of(n: &MachineConstants, b: &BaseParams, t: &ModelTerms, mf: f64) -> Self {
+        let rf = t.resistance.scale.get(k).copied().unwrap_or(1.0);
         let lm = n.lm_h * mf;
         let lr = n.llr_h + lm;
         let ls = b.ls_scale * (n.lls_h + lm);
@@ -208,33 +187,20 @@ impl MachineParts {
             // clamp would panic on the reversed bounds (seen on a 50 hp log's ladder).
             .max(1e-3 * ls)
             .min(0.9 * ls);
+        let l_m = ls - l_sigma;
         // A winding temperature heats the cage too: the fitted rotor time constant is the
         // cold one, and a = Rr/Lr follows the resistance scale.
-        let (a_num, a_den) = match t.dynamics.rotor_flux_tau_s {
-            Some(tau) => (1.0, tau.max(1e-5)),
-            None => (n.rr_ohm * b.ra_scale, lr),
+        let a = match t.dynamics.rotor_flux_tau_s {
+            Some(tau) => rf / tau.max(1e-5),
+            None => n.rr_ohm * b.ra_scale * rf / lr,
         };
-        MachineParts {
-            rs: n.rs_ohm * b.ra_scale,
-            a_num,
-            a_den,
-            l_sigma,
-            l_m: ls - l_sigma,
-        }
-    }
-
-    /// The machine at sample `k` of the terms `t` (its resistance scales there).
-    #[inline(always)]
-    fn at(&self, t: &ModelTerms, k: usize) -> FullMachine {
-        let rf = t.resistance.scale.get(k).copied().unwrap_or(1.0);
         let sf = t.resistance.stator_scale.get(k).copied().unwrap_or(1.0);
-        let a = self.a_num * rf / self.a_den;
         FullMachine {
-            rs: self.rs * rf * sf,
-            rr: a * self.l_m,
-            l_sigma: self.l_sigma,
+            rs: n.rs_ohm * b.ra_scale * rf * sf,
+            rr: a * l_m,
+            l_sigma,
             a,
-            l_m: self.l_m,
+            l_m,
         }
     }
 }
@@ -288,9 +254,6 @@ pub(super) struct FullRun<'a> {
     /// The machine's Lm starts unsaturated at every sample (the stationary model's own
     /// magnetising law acts on it) instead of following the channel's scale.
     unsaturated: bool,
-    /// The machine's parts at every sample, where its Lm is the same at each (unsaturated,
-    /// or no per-sample Lm scale).
-    parts: Option<MachineParts>,
 }
 
 impl<'a> FullRun<'a> {
@@ -305,20 +268,6 @@ impl<'a> FullRun<'a> {
             mech: ModelMechanics::new(n, b),
             x0: FullState::default(),
             unsaturated,
-            parts: None,
-        };
-        let t = run.t;
-        full.parts = if unsaturated {
-            let lm0 = t
-                .magnetising
-                .law
-                .as_ref()
-                .map_or(1.0, MagnetisingLaw::lm0_over_file);
-            Some(MachineParts::of(n, b, t, lm0))
-        } else if t.magnetising.lm_scale.is_empty() {
-            Some(MachineParts::of(n, b, t, 1.0))
-        } else {
-            None
         };
         full.x0 = full_initial_state(d, n, &full.machine(0));
         Some(full)
@@ -327,9 +276,6 @@ impl<'a> FullRun<'a> {
     /// The machine at sample `k`.
     pub(super) fn machine(&self, k: usize) -> FullMachine {
         let ModelRun { n, b, t, .. } = self.run;
-        if let Some(parts) = &self.parts {
-            return parts.at(t, k);
-        }
         if self.unsaturated {
             let lm0 = t
                 .magnetising

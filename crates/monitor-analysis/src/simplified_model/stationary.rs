@@ -41,13 +41,8 @@ struct CageOverSample {
 /// One working sample's machine and shaft for [`simulate_stationary`].
 struct StatMachine<'a> {
     m: FullMachine,
-    /// `1 / L_sigma` of `m` (the stator equation's divisor, once per working sample and not
-    /// at each of RK4's four stages, where it sat on the step's longest chain).
-    inv_l_sigma: f64,
     np: f64,
     mech: ModelMechanics,
-    /// `1 / J` of `mech`.
-    inv_j: f64,
     /// The shaft's extra torques and the sample they are taken at.
     shaft: &'a Shaft,
     k: usize,
@@ -81,9 +76,9 @@ impl StatMachine<'_> {
         // Stator: L_sigma di/dt = v - Rs i - dpsi_R/dt (shorted turns leave the machine
         // symmetric: their loop is drawn at the terminals).
         StatState {
-            i: (v - x.i * m.rs - dpsi) * self.inv_l_sigma,
+            i: (v - x.i * m.rs - dpsi) / m.l_sigma.max(1e-9),
             psi: dpsi,
-            wm: (te - self.mech.btot * x.wm - self.shaft.extra_nm(self.k, x.wm)) * self.inv_j,
+            wm: (te - self.mech.btot * x.wm - self.shaft.extra_nm(self.k, x.wm)) / self.mech.j,
         }
     }
 
@@ -101,7 +96,7 @@ impl StatMachine<'_> {
         StatState {
             i: v - i_s * self.m.rs,
             psi: C64::new(0.0, wr) * x.psi - ri,
-            wm: (te - self.mech.btot * x.wm - self.shaft.extra_nm(self.k, x.wm)) * self.inv_j,
+            wm: (te - self.mech.btot * x.wm - self.shaft.extra_nm(self.k, x.wm)) / self.mech.j,
         }
     }
 
@@ -325,13 +320,10 @@ impl<'a> StatForm<'a> {
         'a: 'g,
     {
         let ModelRun { n, t, .. } = self.full.run;
-        let m = self.full.machine(k);
         let sm = StatMachine {
-            inv_l_sigma: 1.0 / m.l_sigma.max(1e-9),
-            m,
+            m: self.full.machine(k),
             np: n.np,
             mech: self.full.mech,
-            inv_j: 1.0 / self.full.mech.j,
             shaft: &t.shaft,
             k,
             wind: t.stator_winding,

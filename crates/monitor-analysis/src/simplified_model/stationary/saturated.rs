@@ -114,9 +114,7 @@ impl<'a> SatMachine<'a> {
             let psi_m = w / (y + g);
             return ((ps - psi_m) * self.inv_lls, (pr - psi_m) * self.inv_llr);
         }
-        // |w| as the square root of its square (not `norm`'s overflow-safe hypot, a fifth of
-        // this solve's time; a flux linkage is nowhere near the square's overflow).
-        let big_w = w.norm_sqr().sqrt() / self.psi_sat;
+        let big_w = w.norm() / self.psi_sat;
         let mut y = self.guess.get().max(self.inv_lm0);
         for _ in 0..30 {
             let r = (big_w / (y + g)).powf(self.nexp);
