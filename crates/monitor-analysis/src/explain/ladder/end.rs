@@ -11,8 +11,8 @@
 
 use super::base::{base_changes, prior_weight};
 use super::climb::Ladder;
-use super::report::{BaseChange, FinalFit, NotSeparable, Unsteady};
-use super::rules::{PAIRS_ABOVE, UNSTEADY_SHARE};
+use super::report::{BaseChange, FinalFit, LawShape, NotSeparable, Unsteady};
+use super::rules::{PAIRS_ABOVE, SHAPE_TRADE_MAX, UNSTEADY_SHARE};
 use super::rung::{nested_from, setup_list};
 use crate::analysis::{align, Analysis, AnalysisError, FittedEffect, MAX_ITER};
 use crate::effects::EffectModel;
@@ -150,7 +150,11 @@ impl Ladder<'_> {
     /// band ([`super::rules::FLOOR_BAND`] on a short log, [`super::rules::FloorBand`]), the change only trades with the effects' values (or the
     /// other base parameters): it is not separable on this log ([`NotSeparable`]), not a
     /// finding. (A model above the band keeps its changes: the error the effects leave is
-    /// not the change's to carry, and a small true change removes little of it.)
+    /// not the change's to carry, and a small true change removes little of it.) Except
+    /// where the model ends far from its floor (above [`PAIRS_ABOVE`]), the refit without
+    /// the change takes an effect's parameter to the end of its fit range ([`law_shape`])
+    /// and its error stays within [`SHAPE_TRADE_MAX`] times the model's: the change then
+    /// trades with that law's shape ([`LawShape`]), not a finding either.
     fn without_change(
         &self,
         fdata: &Prepared,
@@ -169,9 +173,17 @@ impl Ladder<'_> {
         } else {
             0.0
         };
-        if e_pin / noise > sr.band.ratio {
-            return Ok(None);
-        }
+        let shape = if e_pin / noise > sr.band.ratio {
+            if error / noise <= PAIRS_ABOVE || e_pin > SHAPE_TRADE_MAX * error {
+                return Ok(None);
+            }
+            match law_shape(set, mf, &pinned) {
+                Some(s) => Some(s),
+                None => return Ok(None),
+            }
+        } else {
+            None
+        };
         let traded_with = rung
             .models
             .iter()
@@ -184,6 +196,7 @@ impl Ladder<'_> {
             ratio_without: e_pin / noise,
             removes,
             traded_with,
+            shape,
         }))
     }
 
@@ -313,6 +326,37 @@ fn unsteady(c: &BaseChange, halves: &[Vec<BaseChange>; 2]) -> Option<Unsteady> {
         first: a.change,
         second: b.change,
     })
+}
+
+/// The first effect parameter of the model `set` that the refit `pinned` (a base
+/// parameter held at the file's value) took to an end of its fit range while the fit `mf`
+/// (with the change) kept it inside, by more than a thousandth of the range: the law's
+/// shape ran out where the change was taken away ([`LawShape`]).
+fn law_shape(set: &[ActiveEffect<'_>], mf: &MachineFit, pinned: &MachineFit) -> Option<LawShape> {
+    set.iter()
+        .zip(mf.effect_params.iter().zip(&pinned.effect_params))
+        .find_map(|(a, (with, without))| {
+            a.setup
+                .params
+                .iter()
+                .zip(with.iter().zip(without))
+                .find_map(|(p, (&w, &o))| {
+                    let edge = 1e-3 * (p.hi - p.lo);
+                    let bound = if o >= p.hi - edge {
+                        p.hi
+                    } else if o <= p.lo + edge {
+                        p.lo
+                    } else {
+                        return None;
+                    };
+                    ((w - bound).abs() > edge).then(|| LawShape {
+                        effect: a.effect.kind(),
+                        parameter: p.name.clone(),
+                        with_change: w,
+                        bound,
+                    })
+                })
+        })
 }
 
 /// True when an effect's values `a` and `b` differ by more than 0.5 % of the larger (a

@@ -54,12 +54,13 @@ pub use base::base_changes;
 pub use refusal::{Refusal, Stop, StopReason, Tried, WhatIsLeft, WhyNotPhysical};
 pub use report::{
     Alike, AsOne, BaseChange, Dropped, FinalFit, InPlace, LadderProgress, LadderReport,
-    LadderStart, LadderStep, NotSeparable, RangedValue, SplitInfo, Stratum, TestRule, Unsteady,
+    LadderStart, LadderStep, LawShape, NotSeparable, RangedValue, SplitInfo, Stratum, TestRule,
+    Unsteady,
 };
 pub use rules::{
     FloorBand, AS_ONE_WITHIN, BAND_EXCESS_MIN, BAND_PERIODS, BASE_CHANGE_MIN, EVENT_WINDOW_MAX_S,
     FINALISTS, FLOOR_BAND, IN_PLACE_OF_BASE, LADDER_FIT_SAMPLES, LADDER_MAX_FIT_SAMPLES,
-    PAIRS_ABOVE, PAIR_FROM, SCREEN_ITER, STEP_MIN, UNSTEADY_SHARE, WINDOW_MAX_S,
+    PAIRS_ABOVE, PAIR_FROM, SCREEN_ITER, SHAPE_TRADE_MAX, STEP_MIN, UNSTEADY_SHARE, WINDOW_MAX_S,
     WINDOW_MIN_PERIODS,
 };
 pub use rung::fit_thinning;

@@ -299,7 +299,9 @@ pub struct InPlace {
 
 /// A base change the log cannot tell from the effects' values (JSON
 /// `base_changes[].not_separable`, `final_fit.base[].not_separable`): the chosen model
-/// refitted with the parameter at the file's value.
+/// refitted with the parameter at the file's value. Either that model still reaches the
+/// noise-floor band (`shape: None`), or the chosen model ends far from its floor and, with
+/// the change held off, an effect's law runs to the end of its range ([`LawShape`]).
 #[derive(Debug, Clone, Serialize)]
 pub struct NotSeparable {
     /// The whole-log error without the change.
@@ -311,6 +313,29 @@ pub struct NotSeparable {
     /// The effects whose values took the change up (by more than 0.5 %; empty: none did,
     /// the other base parameters or nothing carry it).
     pub traded_with: Vec<monitor_laws::EffectId>,
+    /// The law that ran to the end of its range with the change held off (`None`: the
+    /// model without the change reaches the floor's band, the first reason).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shape: Option<LawShape>,
+}
+
+/// An effect's parameter the refit without a base change took to the end of its fit range
+/// (JSON `not_separable.shape`), where the chosen model ends far from its noise floor
+/// (above [`super::rules::PAIRS_ABOVE`]): the change and the shape of that effect's law
+/// trade on this log, and the law of the machine is not the library's (motulator's
+/// saturating 2.2 kW machine, whose curve acts on the stator flux of a Gamma circuit: Rr
+/// -23 % beside the library's law, whose knee exponent runs from 8 to its bound 14 with Rr
+/// at the file's value). The change is what the law's shape left, not a finding.
+#[derive(Debug, Clone, Serialize)]
+pub struct LawShape {
+    /// The effect whose law ran out.
+    pub effect: monitor_laws::EffectId,
+    /// Its parameter's JSON key.
+    pub parameter: String,
+    /// The parameter's value in the model with the change.
+    pub with_change: f64,
+    /// The end of the fit range it reached without the change.
+    pub bound: f64,
 }
 
 /// The chosen model refitted on the whole log (JSON `final_fit`).
