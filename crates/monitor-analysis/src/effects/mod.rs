@@ -55,7 +55,7 @@ pub use iron_loss::{IronLoss, IronLossValues};
 pub use load_torque::{load_segments, LoadLevels, LoadSegment, LoadTorque};
 pub use phase_asymmetry::{asymmetry_phase, PhaseAsymmetry, PhaseAsymmetryValues};
 pub use rotor_asymmetry::{RotorAsymmetry, RotorAsymmetryValues, DELTA_BASIS, DELTA_RANGE};
-pub use saturation::{Saturation, SaturationValues};
+pub use saturation::{Saturation, SaturationValues, FLUX_SPAN_MIN};
 pub use setup::{
     declared_values, outside, with_unit, Contribution, EffectParam, EffectValuesError, FitParam,
     FitSetup, SetupError, DIMENSIONLESS,

@@ -26,6 +26,19 @@ pub enum SetupError {
     /// The log holds nothing the effect could fit (the reason in words).
     #[error("{0}")]
     NothingToFit(&'static str),
+    /// The log holds one flux level: its magnetising current (i_f) spans `span_pct` % of
+    /// its median between its 5th and 95th percentiles, below `min_pct` %
+    /// ([`super::FLUX_SPAN_MIN`]). A magnetising curve shows where the flux moves (a
+    /// start, a supply step); on one level the base Lm is all a log can read.
+    #[error(
+        "the log holds one flux level (its magnetising current spans {span_pct} % of its median, {min_pct} % needed): the magnetising curve shows only where the flux moves (a start, a supply step)"
+    )]
+    OneFluxLevel {
+        /// The magnetising current's 5-95 % span over its median [%, rounded].
+        span_pct: u32,
+        /// The least span that shows the curve [%].
+        min_pct: u32,
+    },
     /// A user's law gives no number (NaN or infinity) on this log at its start values.
     #[error("the law gives no number (NaN or infinity) on this log at its start values")]
     NotFinite,
