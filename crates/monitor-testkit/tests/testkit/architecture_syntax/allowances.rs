@@ -1,5 +1,5 @@
 //! The architecture suite's allowances: the files and functions let past its size rules,
-//! each with its reason and its own ceiling (the rules in `tests/architecture.rs`).
+//! each with its reason and its own ceiling (the rules in `tests/testkit/architecture.rs`).
 
 /// Files allowed over 600: (path, lines at most, why).
 pub const LONG_FILES: &[(&str, usize, &str)] = &[
