@@ -40,7 +40,7 @@
 //! ([`samples_per_half_for`], [`LAP_CYCLES_PER_INSTRUCTION_X10`]): at 10 kHz and 170 MHz
 //! one sample per half (a copy 36 917 cycles after the request against 18 831 of slack) and
 //! two (37 177 against 35 831) are lapped, three (37 437 against 52 831) are not. The
-//! host's model (`tests/ring_latency.rs`) runs the sample path against that worst case for
+//! host's model (`tests/firmware/ring_latency.rs`) runs the sample path against that worst case for
 //! a simulated hour and counts no lap.
 //!
 //! **Per sample** ([`SampleBuilder`], what the sample task runs and `cargo qemu-core`
@@ -141,7 +141,7 @@ pub const LOG_MEASURED_BYTES: u32 = 201;
 pub const LOG_MEASURED_INSTRUCTIONS: u32 = 9_440;
 /// The longest frame the firmware logs [bytes]: the status line with the longest name in
 /// each of its six name fields, the frame's timestamp and the framing's overhead
-/// (`tests/ring_latency.rs` computes the bound from the names and fails when the line
+/// (`tests/firmware/ring_latency.rs` computes the bound from the names and fails when the line
 /// outgrows it).
 pub const LOG_FRAME_MAX_BYTES: u32 = 268;
 /// The longest frame's instructions, with interrupts masked: the measured line's cost per
@@ -209,7 +209,7 @@ pub const fn sample_period_cycles(sample_rate_hz: u32) -> u32 {
 /// quarter, 2.6. The ring is sized so that it holds even where the assumption is a quarter
 /// too low: at 2.1 a ring of two samples per half would hold (its copy 30 783 cycles after
 /// the request, the DMA back 35 831 after it), at 2.6 it is lapped (37 177), and three
-/// hold (37 437 against 52 831; up to 3.7 cycles an instruction). `tests/ring_latency.rs`
+/// hold (37 437 against 52 831; up to 3.7 cycles an instruction). `tests/firmware/ring_latency.rs`
 /// runs the board's events at this case.
 pub const LAP_CYCLES_PER_INSTRUCTION_X10: u32 = 26;
 /// Instructions to copy one sample's 2 x 24 words out of the rings (part of

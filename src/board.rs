@@ -47,7 +47,7 @@
 //!
 //! The lamp rows repeat the lamp table below (`panel_lamps!`, the one definition of each
 //! lamp's pin, label and meaning, from which [`Lamp`], the firmware's lamp pins and the
-//! panic handler's pins are generated); a test (`tests/panel_docs.rs`) checks that these
+//! panic handler's pins are generated); a test (`tests/firmware/panel_docs.rs`) checks that these
 //! rows and docs/firmware.md's pin map agree with it. The LEDs other than LD2 are external:
 //! pin -> 330 ohm -> LED anode, cathode to GND (about 4 mA at 3.3 V). The commissioning
 //! record lives in the last 2 KiB flash page, see [`RECORD_FLASH_OFFSET`].

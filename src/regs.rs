@@ -4,10 +4,10 @@
 //!
 //! The blocks are not taken at their fixed addresses but through a [`Bus`]: on the board
 //! [`McuBus`] hands back the MCU's own address (`MCU`, what `src/firmware/*` calls), in the
-//! host tests (`tests/registers.rs`) a memory of the test's own stands behind every
+//! host tests (`tests/firmware/registers.rs`) a memory of the test's own stands behind every
 //! peripheral, and the test reads back word by word, at RM0440's addresses and bits written
 //! out there, what each method wrote, and answers each read. So a wrong register, bit or
-//! value here fails `cargo test`; `src/firmware/*` names no register (`tests/registers.rs`
+//! value here fails `cargo test`; `src/firmware/*` names no register (`tests/firmware/registers.rs`
 //! checks that too) and only calls these methods, around embassy-stm32's drivers.
 //!
 //! The methods, by what they serve:

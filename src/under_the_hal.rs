@@ -3,10 +3,10 @@
 //! embassy-stm32 [`EMBASSY_STM32_CHECKED`]: a new version may own a register the firmware
 //! writes, or do in another order what the firmware works around. Every register access is
 //! one method of the register layer (`src/regs/*.rs`, held to RM0440 by
-//! `tests/registers.rs`), which `src/firmware/*` calls. `tests/under_the_hal.rs` fails when
+//! `tests/firmware/registers.rs`), which `src/firmware/*` calls. `tests/firmware/under_the_hal.rs` fails when
 //! `Cargo.lock` holds another version (read the HAL's source for each entry again, then
 //! change the pin) and when a file of the layer reaches the registers (`pac::`) without an
-//! entry here; `tests/registers.rs` fails when a firmware file names the PAC itself.
+//! entry here; `tests/firmware/registers.rs` fails when a firmware file names the PAC itself.
 //!
 //! | file | registers | why | relies on (embassy-stm32 0.6) |
 //! |---|---|---|---|

@@ -1,6 +1,6 @@
 //! The acquisition's hardware: [`AcqRegisters`] on the STM32G474's ADC1/ADC2 and DMA1
 //! channels 1/2/3, each register access one method of the register layer
-//! (`drive_monitor::regs`, held to RM0440 by `tests/registers.rs`), beside embassy's ring
+//! (`drive_monitor::regs`, held to RM0440 by `tests/firmware/registers.rs`), beside embassy's ring
 //! drivers. The recovery's sequence over them is `drive_monitor::recovery`'s
 //! [`RegisterAcquisition`] (the same code the host tests run on a register-level model).
 //!

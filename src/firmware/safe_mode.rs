@@ -5,7 +5,7 @@
 //! the watchdog: a board that stays in the safe mode until a person presses the reset
 //! button or cycles the power, instead of resetting for ever. Nothing is sampled, and no
 //! flash is touched: the reset log's scan, which a boot loop might come from, is not run
-//! (`tests/boot_bookkeeping.rs` holds this file to that); the boot is counted in the boot
+//! (`tests/firmware/boot_bookkeeping.rs` holds this file to that); the boot is counted in the boot
 //! block's RAM, which the next run writes to the log.
 
 use drive_monitor::app::PANEL_PERIOD_MS;

@@ -1,6 +1,6 @@
 //! The start's hardware: `drive_monitor::startup::StartupHw` on the STM32G474, each register
 //! access one method of the register layer (`drive_monitor::regs`, held to RM0440 by
-//! `tests/registers.rs`), the RAM that survives a reset, the stack's paint and embassy's
+//! `tests/firmware/registers.rs`), the RAM that survives a reset, the stack's paint and embassy's
 //! `init`. The sequence over them (the freeze, the watchdog, the previous run, the clock's
 //! bounded waits, the safe mode, the self-check) is `drive_monitor::startup::start`, the
 //! code the host tests run on a register model.

@@ -3,7 +3,7 @@
 //! code the host's replay runs), so a fault that one operating point cannot name is named
 //! on the panel and the status line as the host names it.
 //!
-//! The case is the one `crates/monitor-studies/tests/operating_points.rs` measures on the host: the 3 hp
+//! The case is the one `crates/monitor-studies/tests/studies/operating_points.rs` measures on the host: the 3 hp
 //! motor (220 V, 60 Hz) at rated load, Ls +50 % at 4.5 s, the viscous load stepped to 0.7
 //! of Bl at 8 s and to 0.5 at 11 s. At rated load an Ls change moves the residuals where an
 //! Rr change and a small speed-sensor error do, so the single point shares it among the

@@ -1,5 +1,5 @@
 //! Shared between the QEMU program and its host-side generator (the root test
-//! `tests/qemu_replay_data.rs`, which simulates the log with sim-host): the monitor configuration of the replay and the binary formats of the
+//! `tests/firmware/qemu_replay_data.rs`, which simulates the log with sim-host): the monitor configuration of the replay and the binary formats of the
 //! embedded log (`data/replay.bin`) and of the host's expected outputs
 //! (`data/expected.bin`). `no_std`, depends only on `monitor_core`.
 //!

@@ -26,7 +26,7 @@ pub struct Machine {
 }
 
 /// The six machines (4-pole): a 0.37 kW machine of per-unit values typical of its size
-/// (made for these tests, see `crates/monitor-io/tests/nameplate.rs`); motulator's
+/// (made for these tests, see `crates/monitor-io/tests/io/nameplate.rs`); motulator's
 /// 2.2 kW (published in inverse-Gamma form: its leakage all on the stator side);
 /// Krause, Wasynczuk and Sudhoff's 3 hp and 50 hp (Analysis of Electric Machinery and
 /// Drive Systems, 60 Hz, Xls = Xlr, with their J); MATLAB/Simscape's 4 kW and 15 kW

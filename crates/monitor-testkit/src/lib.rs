@@ -11,9 +11,9 @@
 //! * [`small_motor`]: the 0.37 kW and 50 hp machines beside the two reference motors.
 //! * [`text`]: the command line's text as a test reads it (a wrapped verdict line joined).
 //! * [`textbook_machine`]: an independent textbook induction machine (the ladder's logs),
-//!   checked against physics by `tests/textbook_machine_physics.rs`.
+//!   checked against physics by `tests/testkit/textbook_machine_physics.rs`.
 //!
-//! Its own tests also hold the workspace's architecture test (`tests/architecture.rs`),
+//! Its own tests also hold the workspace's architecture test (`tests/testkit/architecture.rs`),
 //! which reads every crate's sources.
 
 pub mod analysis_common;

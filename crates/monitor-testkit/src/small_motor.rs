@@ -1,5 +1,5 @@
 //! The 0.37 kW machine the tests use beside the two reference motors (the one of
-//! `crates/monitor-io/tests/nameplate.rs`: made for the tests from per-unit values typical of its size, not a
+//! `crates/monitor-io/tests/io/nameplate.rs`: made for the tests from per-unit values typical of its size, not a
 //! published circuit), and the three motors as a list.
 
 use monitor_core::{MotorParameters, SupplyParameters};

@@ -15,7 +15,7 @@
 //!   the core's 244 and the sampling path's 318 ahead of it, with the clip and encoder
 //!   checks);
 //! - thread mode logs the firmware's status line with its format string (the core's
-//!   `monitor_core::status_line::FORMAT`; `tests/logging_never_blocks.rs` checks that the two
+//!   `monitor_core::status_line::FORMAT`; `tests/firmware/logging_never_blocks.rs` checks that the two
 //!   are the same).
 //!
 //! Two phases of [`SAMPLES_PER_PHASE`] samples, 1 s of the board each: the status line

@@ -5,7 +5,7 @@ Run from the workspace root: `python3 tools/fwtool/scripts/regs_mutants.py`. For
 mutant of `src/regs.rs` and `src/regs/*.rs` (an integer literal in code one higher; a
 peripheral block swapped for another of its type, ADC1 for ADC2, GPIOA for GPIOB, ...; a
 `true` for `false`; a register field's accessor for a sibling's, `set_hseon` for
-`set_pllon`, `teif` for `htif`, ...) it runs `cargo test -p drive-monitor --test registers`
+`set_pllon`, `teif` for `htif`, ...) it runs `cargo test -p drive-monitor --test firmware -- registers::`
 and reports whether the test failed (caught), the build failed (unviable) or the test passed
 (missed), then restores the file. Exits 1 when a mutant is missed. cargo-mutants does not
 make these mutants (it replaces function bodies and operators, not literals or paths).
@@ -17,7 +17,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[3]
 FILES = [ROOT / "src/regs.rs"] + sorted((ROOT / "src/regs").glob("*.rs"))
-TEST = ["cargo", "test", "-q", "-p", "drive-monitor", "--test", "registers"]
+TEST = ["cargo", "test", "-q", "-p", "drive-monitor", "--test", "firmware", "--", "registers::"]
 
 # Accessors swapped within each group (same signature, another field of the register).
 SIBLINGS = [

@@ -30,8 +30,8 @@
 //!
 //! The QEMU program's data (`crates/core-on-m4/data/{replay,expected}.bin`) is a log from
 //! the sim-host simulator and the host build's answers to it; the root test
-//! `tests/qemu_replay_data.rs` checks it is current and regenerates it with
-//! `REGENERATE_QEMU_DATA=1 cargo test --test qemu_replay_data`.
+//! `tests/firmware/qemu_replay_data.rs` checks it is current and regenerates it with
+//! `REGENERATE_QEMU_DATA=1 cargo test --test firmware -- qemu_replay_data::`.
 //!
 //! Cargo runs this tool with the workspace root as the directory of the alias call; the
 //! tool locates the root from its own manifest directory, so it works from anywhere.

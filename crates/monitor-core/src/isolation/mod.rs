@@ -143,7 +143,7 @@
 //! # How sure a name is
 //! The probabilities are meant as calibrated ones: of the faults named at probability p,
 //! about p are right (measured on simulated logs the rules were not tuned on: the host's
-//! `tests/isolation_calibration.rs`, docs/isolation.md "How often a name is right"). What
+//! `crates/monitor-studies/tests/studies/isolation_calibration.rs`, docs/isolation.md "How often a name is right"). What
 //! keeps them so:
 //!
 //! - **The directions' own uncertainty.** Each fault's direction is computed on the

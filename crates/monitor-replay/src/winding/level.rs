@@ -42,7 +42,7 @@ use serde::Serialize;
 /// resistance (the simulator's default `fault_resistance_ohm`, Rs/10).
 pub const FAULT_RESISTANCE_OF_RS: f32 = 0.1;
 /// The fault path's resistance the interval spans (fractions of the phase resistance):
-/// what `tests/turn_fault.rs` injects, from a nearly bolted short to one through a fifth
+/// what `tests/replay/turn_fault.rs` injects, from a nearly bolted short to one through a fifth
 /// of the phase's resistance.
 pub const FAULT_RESISTANCE_RANGE: (f32, f32) = (0.05, 0.2);
 /// The lowest winding resistance the interval takes, as a fraction of the file's Rs: a

@@ -31,8 +31,9 @@
 //! plausibly from the first, used to pass (the second judged against the last good count
 //! two rows back, with twice the room) while the true count after it was held out: the
 //! count handed on jumped out and back, and the monitor, whose own bound is `N_max / K`,
-//! flagged the speed sensor (`tests/bad_encoder_cells.rs`). A genuine speed change moves
-//! the count by far less: a 2.2 kW motor starting direct-on-line at 2000 rad/s^2 changes its
+//! flagged the speed sensor (`crates/monitor-api/tests/api/bad_encoder_cells.rs`). A genuine
+//! speed change moves the count by far less: a 2.2 kW motor starting direct-on-line at
+//! 2000 rad/s^2 changes its
 //! step by 0.3 counts per row at 5 kHz, 1.3 at 1 kHz, against `e_max` of 10 and 43.
 
 /// Counts per revolution the replay assumes for `enc_count` (4 x 1024 lines, the core's

@@ -1,6 +1,6 @@
 //! Evidence across operating points: on the 3 hp motor at rated load an Ls change moves the
 //! residuals where an Rr change and a small speed-sensor error do, so one operating point
-//! cannot name it (`tests/isolation.rs` lists it as not separable there). Once the log holds
+//! cannot name it (`isolation.rs`, beside it, lists it as not separable there). Once the log holds
 //! two or three load levels 30-50 % apart after the fault, the joint fit over them (the
 //! stator-voltage equations only: the load as an unknown input) names it with its size. A
 //! healthy log with the same load steps names nothing, and a fault one point already names

@@ -17,9 +17,8 @@
 //! (`tests/` folders, benches, and the items carrying `#[cfg(test)]` or `#[test]`, wherever
 //! they stand: the code after them is read).
 
-// The architecture suite's file walker; only part of it is used here.
-#[allow(dead_code)]
-mod architecture_syntax;
+// The architecture suite's file walker (declared once in `main.rs`, beside `architecture`).
+use crate::architecture_syntax;
 
 use architecture_syntax::files::{files, is_code, is_test_file, read, verdict};
 // The engine crates: they return typed values, never a front end's words.

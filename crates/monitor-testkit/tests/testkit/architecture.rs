@@ -52,7 +52,7 @@
 //! The files are those git tracks (`git ls-files`), or, without git, every file below the
 //! workspace outside `target/` and hidden folders.
 
-mod architecture_syntax;
+use crate::architecture_syntax;
 
 use architecture_syntax::allowances::{LONG_FILES, LONG_FUNCTIONS};
 use architecture_syntax::circles::{circles, reached, ModPath};

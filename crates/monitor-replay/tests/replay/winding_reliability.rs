@@ -10,7 +10,7 @@
 //! phases named at 0.5 or more, at least 95 % are right. The table printed is the one in
 //! `docs/isolation.md`:
 //! ```text
-//! cargo test --release -p monitor-replay --test winding_reliability -- --nocapture
+//! cargo test --release -p monitor-replay --test replay -- winding_reliability:: --nocapture
 //! ```
 //! `MONITOR_FULL_SWEEPS=1` draws four times as many simulated logs.
 

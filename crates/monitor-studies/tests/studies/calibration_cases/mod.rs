@@ -1,4 +1,4 @@
-//! The cases of the isolation's calibration (`tests/isolation_calibration.rs`): each drawn
+//! The cases of the isolation's calibration (`isolation_calibration.rs`, beside it): each drawn
 //! from its seed, simulated and replayed (its module docs say what is drawn).
 #![allow(dead_code)]
 

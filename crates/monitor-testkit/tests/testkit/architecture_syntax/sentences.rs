@@ -336,7 +336,7 @@ fn no_engine_builds_a_sentence() {
 }
 
 /// The measure behind rule 9: the engines' sentences by crate and place
-/// (`cargo test -p monitor-testkit --test architecture -- --ignored --nocapture sentences_by_crate`).
+/// (`cargo test -p monitor-testkit --test testkit -- --ignored --nocapture sentences_by_crate`).
 #[test]
 #[ignore]
 fn sentences_by_crate() {

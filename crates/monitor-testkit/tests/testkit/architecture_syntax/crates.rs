@@ -21,7 +21,7 @@ pub const CRATE_SOURCES: [&str; 13] = [
 ];
 
 /// The workspace's crates by the names code uses (every package, checked by
-/// `the_crate_list_names_every_package` in `tests/architecture.rs`).
+/// `the_crate_list_names_every_package` in `tests/testkit/architecture.rs`).
 pub const WORKSPACE_CRATES: [&str; 18] = [
     "drive_monitor",
     "sim_host",

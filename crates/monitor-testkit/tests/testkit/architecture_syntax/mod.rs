@@ -1,4 +1,4 @@
-//! The syntax the architecture test (`tests/architecture.rs`) reads: every path and `use`
+//! The syntax the architecture test (`tests/testkit/architecture.rs`) reads: every path and `use`
 //! of a file with the module it is written in ([`Paths`]), the top module a path reaches
 //! ([`top_module`]), a file's module path ([`module_of`]), the long functions outside
 //! tests ([`LongFunctions`]), and what an engine may not spell ([`spelling`], rule 8, with

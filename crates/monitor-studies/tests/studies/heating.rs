@@ -21,7 +21,7 @@
 //! test profile on 2 cores. A real motor's thermal time constant (30 min) runs with `MONITOR_FULL_SWEEPS=1`
 //! as 1 h logs at 1 kHz on two motors (`.ci/run` runs it).
 
-mod small_motor;
+use crate::small_motor;
 
 use monitor_core::Fault;
 use monitor_io::params::ParamFile;

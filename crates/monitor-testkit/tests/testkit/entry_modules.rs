@@ -8,9 +8,8 @@
 //! entry (paths inside `#[cfg(test)]` modules and `tests.rs` files are left out), with the
 //! architecture suite's path reader.
 
-// The architecture suite's file walker; only part of it is used here.
-#[allow(dead_code)]
-mod architecture_syntax;
+// The architecture suite's file walker (declared once in `main.rs`, beside `architecture`).
+use crate::architecture_syntax;
 
 use architecture_syntax::circles::{reached, ModPath};
 use architecture_syntax::files::{files, parse, verdict};

@@ -3,7 +3,7 @@
 //! not judge", never with "healthy" while the residuals sit at many times their bands.
 //!
 //! Three motors (the 3 hp and 2.2 kW reference motors and a 0.37 kW machine of per-unit
-//! values typical of its size, the one of `crates/monitor-io/tests/nameplate.rs`), each sensor's gain stepped
+//! values typical of its size, the one of `crates/monitor-io/tests/io/nameplate.rs`), each sensor's gain stepped
 //! by -50, -5, +5, +20 and +50 % at 5 s of an 8 s log at 5 kHz, commissioned on the healthy
 //! running over 1.5-4 s. Also: a speed-sensor gain step is not reported as a load or
 //! voltage change (the operating point is judged without the speed-dependent d-q frame),

@@ -9,10 +9,10 @@
 //! `Monitor` at every 100th sample.
 //!
 //! After a change to the core or to the scenario, regenerate with
-//! `REGENERATE_QEMU_DATA=1 cargo test --test qemu_replay_data` and commit the files; then
+//! `REGENERATE_QEMU_DATA=1 cargo test --test firmware -- qemu_replay_data::` and commit the files; then
 //! `cargo qemu-core` checks the Cortex-M4F build against them.
 
-#[path = "../crates/core-on-m4/src/scenario.rs"]
+#[path = "../../crates/core-on-m4/src/scenario.rs"]
 #[allow(dead_code, missing_docs)]
 mod scenario;
 
@@ -95,10 +95,10 @@ fn qemu_replay_data_is_the_simulated_log_and_the_hosts_answers() {
     let committed_expected = std::fs::read(dir.join("expected.bin")).expect("expected.bin");
     assert!(
         committed_replay == replay,
-        "crates/core-on-m4/data/replay.bin is stale: REGENERATE_QEMU_DATA=1 cargo test --test qemu_replay_data"
+        "crates/core-on-m4/data/replay.bin is stale: REGENERATE_QEMU_DATA=1 cargo test --test firmware -- qemu_replay_data::"
     );
     assert!(
         committed_expected == expected,
-        "crates/core-on-m4/data/expected.bin is stale: REGENERATE_QEMU_DATA=1 cargo test --test qemu_replay_data"
+        "crates/core-on-m4/data/expected.bin is stale: REGENERATE_QEMU_DATA=1 cargo test --test firmware -- qemu_replay_data::"
     );
 }

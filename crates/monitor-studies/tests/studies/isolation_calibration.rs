@@ -28,7 +28,7 @@
 //! profile on 2 cores); `cargo test` runs a small sweep (seeds
 //! 4_880_000.., 48 cases, about 6 s). Print the tables with `-- --nocapture`.
 
-mod calibration_cases;
+use crate::calibration_cases;
 
 use calibration_cases::{draw, motors, right_name, run, CaseOutcome, Scored};
 use rayon::prelude::*;

@@ -21,7 +21,7 @@
 //!
 //! Twelve 40-70 s replays at 2 kHz: a few seconds in the test profile on 2 cores.
 
-mod small_motor;
+use crate::small_motor;
 
 use monitor_core::Fault;
 use monitor_io::log::{ChannelUnit, Column, ColumnMapping, LogFile, OpenOptions, Row};
