@@ -21,13 +21,13 @@
 //!
 //! A per-case table goes to stderr (`-- --nocapture`). By default a representative subset
 //! runs (one single effect per motor size, a pair, a control); `MONITOR_FULL_SWEEPS=1`
-//! runs the whole matrix (tests/analysis_common/mod.rs):
+//! runs the whole matrix (tests/cli/analysis_common.rs):
 //! ```text
-//! MONITOR_FULL_SWEEPS=1 cargo test --release -p sim-host --test ladder_matrix -- --nocapture
+//! MONITOR_FULL_SWEEPS=1 cargo test --release -p sim-host --test cli ladder_matrix:: -- --nocapture
 //! ```
 #![allow(missing_docs)]
 
-mod analysis_common;
+use crate::analysis_common;
 use monitor_testkit::textbook_machine;
 
 use std::collections::BTreeSet;

@@ -253,7 +253,7 @@ fn bad_csv_inputs_give_one_line_errors_naming_the_problem() {
     // LF, and the same from a Windows editor (CRLF): the same line number.
     for (name, eol) in [("nonnum.csv", "\n"), ("crlf.csv", "\r\n")] {
         // (Text in the time column: a row that cannot be placed. Text in a measured
-        // column is a bad cell, tests/text_cells.rs.)
+        // column is a bad cell, tests/cli/text_cells.rs.)
         let text = ["t_s,ia_A,ib_A,ic_A", "0,1,2,-3", "0.0001x,1,2,-3", ""].join(eol);
         let bad = write(dir.path(), name, &text);
         let e = fails(&["diagnose", "--params", p, bad.to_str().expect("utf8")]);

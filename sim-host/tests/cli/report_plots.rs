@@ -7,7 +7,7 @@
 //! error drawn per supply period is its RMS and says so, and the ladder's steps are whole
 //! ticks named by what each step added.
 
-mod chart_legend;
+use crate::chart_legend;
 
 use assert_cmd::Command;
 use std::path::{Path, PathBuf};

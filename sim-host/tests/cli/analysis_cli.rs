@@ -1,6 +1,6 @@
 //! `compare` and `explain` through the real binary (assert_cmd): JSON keys, plots and
 //! report files, the accumulate workflow, and one-line errors on bad input.
-mod analysis_common;
+use crate::analysis_common;
 use analysis_common::*;
 use assert_cmd::Command;
 

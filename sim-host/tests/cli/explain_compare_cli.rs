@@ -1,6 +1,6 @@
 //! `explain --compare`: compare and explain on one read of the log, with the same figures as
 //! the two commands run separately.
-mod analysis_common;
+use crate::analysis_common;
 use analysis_common::*;
 use assert_cmd::Command;
 use monitor_analysis::EffectId;

@@ -1,4 +1,4 @@
-//! The log writers of a data-acquisition system (`tests/column_mapping.rs`): its channels
+//! The log writers of a data-acquisition system (`tests/cli/column_mapping.rs`): its channels
 //! named and ordered its way, with an extra channel, time in ms (or ISO 8601 text, or a
 //! Parquet timestamp), currents in mA and speed in rpm, in CSV, TDMS and Parquet.
 

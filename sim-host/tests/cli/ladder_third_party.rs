@@ -40,7 +40,7 @@
 //!
 //! Part of the full sweeps only: `cargo test` skips it with a note, and
 //! ```text
-//! MONITOR_FULL_SWEEPS=1 cargo test --release -p sim-host --test ladder_third_party -- --nocapture
+//! MONITOR_FULL_SWEEPS=1 cargo test --release -p sim-host --test cli ladder_third_party:: -- --nocapture
 //! ```
 //! runs it (14 logs, two of them 40 s long, one at a time; the table goes to stderr).
 #![allow(missing_docs)]

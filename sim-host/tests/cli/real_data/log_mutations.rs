@@ -1,5 +1,5 @@
 //! What a data-acquisition system or a careless export does to a log
-//! (`tests/real_data.rs`): each mutation named, with what the data-quality stage must
+//! (`tests/cli/real_data.rs`): each mutation named, with what the data-quality stage must
 //! report about it.
 
 use super::f;

@@ -11,7 +11,7 @@
 //! caught by the same check; the banner is at most two lines at A4's width, and every
 //! legend entry's colour is drawn. Screenshots go to the test's temporary folder.
 
-mod chart_legend;
+use crate::chart_legend;
 
 use assert_cmd::Command;
 use monitor_testkit::text::verdict_line_of;

@@ -421,7 +421,7 @@ fn missing_values_duplicates_and_blank_lines_follow_one_rule() {
 
 /// Writes `examples/logs/daq_2p2kw.csv`: the run of `examples/scenarios/daq_2p2kw.toml`
 /// as a data-acquisition system writes it. Run on purpose only:
-/// `cargo test -p sim-host --test column_mapping -- --ignored write_the_daq_example`.
+/// `cargo test -p sim-host --test cli -- --ignored column_mapping::write_the_daq_example`.
 #[test]
 #[ignore = "writes the example log under examples/; run on purpose"]
 fn write_the_daq_example() {

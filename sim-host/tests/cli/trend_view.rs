@@ -6,7 +6,7 @@
 //! The store is built here: four logs of one motor (Rs 0/+10/+20/+40 %, each a FAULT
 //! verdict) with the residuals and the load the test sets.
 
-mod chart_legend;
+use crate::chart_legend;
 
 use assert_cmd::Command;
 use monitor_store::row::column_index;

@@ -1,7 +1,7 @@
 //! `sim-host identify`, the command: the motulator log (a simulator this project did not
 //! write) from its nameplate estimate, bad input is one line, the help, and the command
 //! never writes over its inputs. (The identification itself against six known circuits,
-//! the library's `monitor_analysis::identify`: `crates/monitor-analysis/tests/identify.rs`.)
+//! the library's `monitor_analysis::identify`: `crates/monitor-analysis/tests/analysis/identify.rs`.)
 
 use assert_cmd::Command;
 use monitor_analysis::identify::InverseGamma;

@@ -7,7 +7,7 @@
 //! (windage, Coulomb friction); `MONITOR_FULL_SWEEPS=1` runs all nine, and a long log at a
 //! low rate (40 s at 2 kHz of a small machine warming, with its control):
 //! ```text
-//! MONITOR_FULL_SWEEPS=1 cargo test --release -p sim-host --test ladder_scenarios -- --nocapture
+//! MONITOR_FULL_SWEEPS=1 cargo test --release -p sim-host --test cli ladder_scenarios:: -- --nocapture
 //! ```
 use assert_cmd::Command;
 use std::path::{Path, PathBuf};

@@ -20,7 +20,7 @@
 //! Each case is a ladder of about 20-30 CPU-s in release, so the cases run under
 //! `MONITOR_FULL_SWEEPS=1` only (a plain `cargo test` prints a note and passes):
 //! ```text
-//! MONITOR_FULL_SWEEPS=1 cargo test --release -p sim-host --test ladder_broken_bars -- --nocapture
+//! MONITOR_FULL_SWEEPS=1 cargo test --release -p sim-host --test cli ladder_broken_bars:: -- --nocapture
 //! ```
 #![allow(missing_docs)]
 
@@ -301,7 +301,7 @@ mod short_records {
         let tmp = tempfile::tempdir().expect("tempdir");
         let dir = tmp.path();
         let params = dir.join("machine.toml");
-        let file = include_str!("../../examples/params/2p2kw.toml").replacen(
+        let file = include_str!("../../../examples/params/2p2kw.toml").replacen(
             "[motor]\n",
             "[motor]\nrotor_bars = 28\n",
             1,
