@@ -7,7 +7,7 @@
 //! representative subset (each effect on one motor at one rate, every motor and every rate
 //! on some effect); `MONITOR_FULL_SWEEPS=1` checks every case (`analysis_common`'s module
 //! doc; `.ci/run` runs it).
-mod analysis_common;
+use crate::analysis_common;
 mod dynamics_recovery;
 
 use analysis_common::*;

@@ -13,7 +13,7 @@
 //! configurations (every configuration checks some) and the effect-free logs on two of the
 //! six; `MONITOR_FULL_SWEEPS=1` checks every effect on every configuration and every
 //! effect-free log (`analysis_common`'s module doc; `.ci/run` runs it).
-mod analysis_common;
+use crate::analysis_common;
 use analysis_common::*;
 use monitor_core::EffectKind;
 use monitor_sim::EffectSpec;

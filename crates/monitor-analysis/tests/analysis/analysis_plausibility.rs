@@ -1,6 +1,6 @@
 //! Plausibility of fitted values, identifiability of the base parameters, and the advice
 //! `compare` gives when its worst windows are a start or a step (issue 10).
-mod analysis_common;
+use crate::analysis_common;
 use analysis_common::*;
 use monitor_analysis::compare::NotIdentifiedWhy;
 use monitor_analysis::effects::library;

@@ -1,5 +1,5 @@
 //! Exploratory probe (ignored): prints the explain ranking for every effect scenario.
-mod analysis_common;
+use crate::analysis_common;
 use analysis_common::*;
 
 #[test]
@@ -135,7 +135,7 @@ fn probe() {
     }
 }
 
-/// Read-speed probe (ignored): `ANALYSIS_BENCH_LOG=... cargo test -p monitor-analysis --test analysis_probe read_speed -- --ignored --nocapture`.
+/// Read-speed probe (ignored): `ANALYSIS_BENCH_LOG=... cargo test -p monitor-analysis --test analysis analysis_probe::read_speed -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn read_speed() {

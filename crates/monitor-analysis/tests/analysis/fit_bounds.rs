@@ -11,7 +11,7 @@
 //! and none the ladder's end reports as plausible, sits at a bound of its fit or outside its
 //! physical range, judged against the effect's own set-up on the log (not the fit's flag).
 
-mod analysis_common;
+use crate::analysis_common;
 use analysis_common::*;
 use monitor_analysis::effects::{self, EffectModel, Saturation};
 use monitor_analysis::{Analysis, ParamValue};

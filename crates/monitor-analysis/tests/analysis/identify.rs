@@ -7,7 +7,7 @@
 //! same circuit with the start file's leakage split (1 %; the split is what no terminal log
 //! can tell). Also: a log that cannot identify some parameters says so, and the identified
 //! parameters name the same faults as the true ones. (The command, `sim-host identify`:
-//! `sim-host/tests/identify.rs`.) The machines: `monitor_testkit::identify_machines`.
+//! `sim-host/tests/cli/identify.rs`.) The machines: `monitor_testkit::identify_machines`.
 //!
 //! All ten runs (3 s logs) take about 2 s in the test profile.
 

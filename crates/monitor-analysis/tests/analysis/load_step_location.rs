@@ -2,7 +2,7 @@
 //! `monitor_analysis::change_point`): one step in the log is one step in the fit, where
 //! it is and of its size, on a log another simulator made and on the project's simulator;
 //! a log without a step gets none.
-mod analysis_common;
+use crate::analysis_common;
 use analysis_common::*;
 use monitor_analysis::effects::{load_segments, model_of, LoadSegment};
 use monitor_analysis::{Analysis, FittedEffect};

@@ -14,7 +14,7 @@
 //! noisy ones; with `MONITOR_FULL_SWEEPS=1` every motor, bar count and rate
 //! (`analysis_common`'s module doc).
 
-mod analysis_common;
+use crate::analysis_common;
 
 use analysis_common::{analyse, loaded_start, motor, settle_s, sweep, write_log};
 use monitor_analysis::rotor_asymmetry::{fit_and_spectrum_agree, mcsa, McsaReport, MIN_BINS};

@@ -9,11 +9,11 @@
 //!
 //! The figures (`--nocapture`) are the accuracy table of docs/model-vs-measurement.md:
 //! ```text
-//! MONITOR_FULL_SWEEPS=1 cargo test --release -p monitor-analysis --test noise_floor -- --nocapture
+//! MONITOR_FULL_SWEEPS=1 cargo test --release -p monitor-analysis --test analysis noise_floor:: -- --nocapture
 //! ```
 //! By default a representative subset runs (each log source once, each rate once); the
 //! thermal-drift logs (40 s) run with `MONITOR_FULL_SWEEPS=1` only (`.ci/run` runs it).
-mod analysis_common;
+use crate::analysis_common;
 use analysis_common::*;
 use monitor_io::log::{Channels, Log, Row};
 use monitor_io::params::{ParamFile, SensorRanges};

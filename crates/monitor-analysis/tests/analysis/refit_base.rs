@@ -8,7 +8,7 @@
 //! two parameters 20 % off (or Rs and Rr both half their true values), never the truth.
 //! By default one case per file error is checked; `MONITOR_FULL_SWEEPS=1` checks every
 //! effect on both motors with every file error.
-mod analysis_common;
+use crate::analysis_common;
 use analysis_common::*;
 use monitor_analysis::refit::BaseRefit;
 use monitor_analysis::simplified_model::BaseParameter;

@@ -11,7 +11,7 @@
 //! of both motors at both loads and healthy logs of both (`analysis_common`'s module doc;
 //! `.ci/run` runs it).
 
-mod analysis_common;
+use crate::analysis_common;
 
 use analysis_common::{
     analyse, in_this_run, loaded_start, motor, opts, settle_s, sweep, write_log,

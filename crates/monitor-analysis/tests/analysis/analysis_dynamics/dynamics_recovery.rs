@@ -1,4 +1,4 @@
-//! The effect library inside the full-order machine (`tests/analysis_dynamics.rs`): each
+//! The effect library inside the full-order machine (`tests/analysis/analysis_dynamics.rs`): each
 //! effect's fitted parameters are what the simulator injected, through a start and steps.
 
 use super::*;
