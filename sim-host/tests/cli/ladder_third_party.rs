@@ -31,12 +31,7 @@
 //!   file's R_R is 10.1 % low, so a true +11.2 %); issue 87: beside motulator's saturation
 //!   law the ladder reported rr -23 % and -25 % where the machine's is +6 %.
 //!
-//! The ladder's JSON read here: `start` {error, ...}; `ladder`, the rungs in order, each
-//! with `error` and `ratio_to_floor`; an effect rung with `effect`, `added` and perhaps
-//! `dropped` (earlier effects a later one explains), a base rung with `base` (rs, rr, lls,
-//! llr, lm, j, b), `change` (relative: 0.19 = +19 %) and `interval`; `final_effects`;
-//! `base_changes` (a list of {base, change, interval}). A JSON without base changes counts
-//! a warm stator as missed.
+//! The ladder's JSON is read in `outcome` (its module doc says which fields).
 //!
 //! Part of the full sweeps only: `cargo test` skips it with a note, and
 //! ```text
@@ -45,12 +40,13 @@
 //! runs it (14 logs, two of them 40 s long, one at a time; the table goes to stderr).
 #![allow(missing_docs)]
 
-use assert_cmd::Command;
 use monitor_testkit::analysis_common::in_this_run;
 use serde::Deserialize;
-use serde_json::Value;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
+
+mod outcome;
+use outcome::{run, Outcome};
 
 /// The folder of the logs, their parameter files and the manifest.
 fn data() -> PathBuf {
@@ -125,132 +121,6 @@ const WARM: &str = "warm_stator";
 const WARM_TOL: f64 = 0.05;
 /// Largest |rs change| on a log whose stator is at the file's temperature.
 const RS_STILL: f64 = 0.03;
-
-/// A base change: the parameter, its relative change, its interval.
-#[derive(Clone, Debug)]
-struct Base {
-    name: String,
-    change: f64,
-    interval: Option<(f64, f64)>,
-}
-
-/// What the ladder did on one log.
-struct Outcome {
-    entry: Entry,
-    /// Effects in the model at the end (`final_effects`).
-    named: BTreeSet<String>,
-    /// Every effect some rung added, and every effect some rung dropped.
-    added: BTreeSet<String>,
-    dropped: BTreeSet<String>,
-    base: Vec<Base>,
-    /// Whether the JSON carries base changes at all (top-level or as rungs).
-    has_base: bool,
-    /// start.error, then each rung's error.
-    errors: Vec<f64>,
-    end_ratio: f64,
-    /// Each rung: what it did, its error and ratio to the floor.
-    rungs: Vec<(String, f64, f64)>,
-    stop: String,
-    stopped_because: String,
-    seconds: f64,
-    /// The command failed (its stderr).
-    failed: Option<String>,
-    /// The ladder's JSON document.
-    json: Value,
-}
-
-fn strings(v: &Value) -> Vec<String> {
-    v.as_array()
-        .into_iter()
-        .flatten()
-        .filter_map(|s| s.as_str().map(str::to_string))
-        .collect()
-}
-
-fn num(v: &Value) -> f64 {
-    v.as_f64().unwrap_or(f64::NAN)
-}
-
-fn base_of(v: &Value) -> Option<Base> {
-    let name = v["base"].as_str()?.to_string();
-    let i = v["interval"].as_array();
-    let interval = i.filter(|i| i.len() == 2).map(|i| (num(&i[0]), num(&i[1])));
-    Some(Base {
-        name,
-        change: num(&v["change"]),
-        interval,
-    })
-}
-
-fn run(e: &Entry) -> Outcome {
-    let t = std::time::Instant::now();
-    let out = Command::cargo_bin("sim-host")
-        .expect("the sim-host binary")
-        .args(["explain", "--ladder", "--json", "--params"])
-        .arg(data().join(&e.params))
-        .arg(data().join(&e.csv))
-        .output()
-        .expect("run sim-host");
-    let mut o = Outcome {
-        entry: e.clone(),
-        named: BTreeSet::new(),
-        added: BTreeSet::new(),
-        dropped: BTreeSet::new(),
-        base: Vec::new(),
-        has_base: false,
-        errors: Vec::new(),
-        end_ratio: f64::NAN,
-        rungs: Vec::new(),
-        stop: "error".into(),
-        stopped_because: String::new(),
-        seconds: t.elapsed().as_secs_f64(),
-        failed: None,
-        json: Value::Null,
-    };
-    if !out.status.success() {
-        o.failed = Some(String::from_utf8_lossy(&out.stderr).into_owned());
-        return o;
-    }
-    let j: Value = serde_json::from_slice(&out.stdout).expect("one JSON document");
-    o.errors.push(num(&j["start"]["error"]));
-    o.end_ratio = num(&j["start"]["ratio_to_floor"]);
-    for r in j["ladder"].as_array().into_iter().flatten() {
-        o.errors.push(num(&r["error"]));
-        o.end_ratio = num(&r["ratio_to_floor"]);
-        let what = if let Some(b) = base_of(r) {
-            let w = format!("base {} {:+.1} %", b.name, 100.0 * b.change);
-            o.base.push(b);
-            w
-        } else {
-            let (a, d) = (strings(&r["added"]), strings(&r["dropped"]));
-            o.added.extend(a.iter().cloned());
-            o.dropped.extend(d.iter().cloned());
-            let mut w = format!("+{}", a.join(" +"));
-            if !d.is_empty() {
-                w += &format!(" -{}", d.join(" -"));
-            }
-            w
-        };
-        o.rungs
-            .push((what, num(&r["error"]), num(&r["ratio_to_floor"])));
-    }
-    if let Some(list) = j["base_changes"].as_array() {
-        o.base = list.iter().filter_map(base_of).collect();
-        o.has_base = true;
-    }
-    o.has_base |= !o.base.is_empty();
-    o.named = match j.get("final_effects") {
-        Some(f) => strings(f).into_iter().collect(),
-        None => o.added.difference(&o.dropped).cloned().collect(),
-    };
-    o.json = j.clone();
-    o.stop = j["stop"].as_str().unwrap_or_default().to_string();
-    o.stopped_because = j["stopped_because"]
-        .as_str()
-        .unwrap_or_default()
-        .to_string();
-    o
-}
 
 impl Outcome {
     /// The change of `rs` the ladder reports (0 when it reports none).
