@@ -7,7 +7,7 @@ simulator, the version pinned in requirements.txt), writes each as a CSV in the 
 log schema with 12-bit sensors, writes the parameter file a USER would have for each machine
 (nameplate, DC resistance, no-load and locked-rotor tests: never the simulator's truth), and
 a manifest with the hidden effects, their true sizes and the machines' true values. The guard
-is `sim-host/tests/ladder_third_party.rs`; README.md beside this file says how to run it.
+is `sim-host/tests/cli/ladder_third_party.rs`; README.md beside this file says how to run it.
 The user-law logs (issue 85, `USER_LAW_LOGS`) hide laws the monitor's library lacks, each
 with the law file a user would write for it (`laws/`) and, for the foreign magnetising
 curve, the machine's no-load test table.
@@ -1143,7 +1143,7 @@ def main():
         print(f"{name}: " + ", ".join(f"{k} {v:.4g}" for k, v in f.items()))
 
     manifest = [
-        "# The third-party guard's logs (sim-host/tests/ladder_third_party.rs): made by",
+        "# The third-party guard's logs (sim-host/tests/cli/ladder_third_party.rs): made by",
         f"# tools/motulator-logs/generate.py with motulator {MOTULATOR}, numpy "
         f"{np.__version__}.",
         "# Regenerate them with the generator, never by hand.",

@@ -12,7 +12,7 @@
 //! one rate, every motor and rate on some effect); with the environment variable
 //! `MONITOR_FULL_SWEEPS=1` they run whole (`.ci/run` does, after `cargo test`):
 //! ```text
-//! MONITOR_FULL_SWEEPS=1 cargo test -p monitor-analysis --test analysis_dynamics --test analysis_effects --test rotor_asymmetry
+//! MONITOR_FULL_SWEEPS=1 cargo test -p monitor-analysis --test analysis -- analysis_dynamics:: analysis_effects:: rotor_asymmetry::
 //! ```
 #![allow(dead_code, missing_docs)]
 

@@ -1,5 +1,5 @@
-//! The six machines the `identify` tests identify (`crates/monitor-analysis/tests/identify.rs`,
-//! the library; `sim-host/tests/identify.rs`, the command), each with its published circuit,
+//! The six machines the `identify` tests identify (`crates/monitor-analysis/tests/analysis/identify.rs`,
+//! the library; `sim-host/tests/cli/identify.rs`, the command), each with its published circuit,
 //! its nameplate (computed from that circuit) and the start file `params from-nameplate`
 //! estimates from it.
 

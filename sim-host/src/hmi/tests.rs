@@ -1,8 +1,8 @@
 //! The live HMI's three sources, tested through the library (`sim_host::hmi`): the live
 //! simulation with its keys, a replay of a small simulated log through the data-quality stage
 //! and the core, and the firmware's status lines (the board's own writer). The binary's own
-//! tests (`hmi --stdin`, `--help`, a log replay's options) are in `sim-host/tests/hmi.rs`;
-//! a real terminal in `sim-host/tests/hmi_tmux.rs`.
+//! tests (`hmi --stdin`, `--help`, a log replay's options) are in `sim-host/tests/cli/hmi.rs`;
+//! a real terminal in `sim-host/tests/cli/hmi_tmux.rs`.
 
 use crate::hmi::live::LiveSim;
 use crate::hmi::log_replay::LogReplay;

@@ -17,7 +17,7 @@
 //!
 //! The effects, their parameters and the changes to the model are listed in
 //! docs/design.md §9; its table of the parameters is checked against the declarations
-//! (`crates/monitor-analysis/tests/effect_parameters.rs`).
+//! (`crates/monitor-analysis/tests/analysis/effect_parameters.rs`).
 //!
 //! With `d_axis_dynamics` or `cross_coupling_dynamics` in the model, the model is the
 //! full-order machine of `simplified_model::simulate` (inverse-Gamma form, states I_ds,

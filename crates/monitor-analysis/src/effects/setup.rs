@@ -60,7 +60,7 @@ fn because_of(because: &str) -> String {
 /// unit, meaning, physical range and that range's source. The fit's set-up
 /// ([`EffectParam::fit`]), the JSON (`parameters`, keyed by the name, with the unit) and
 /// docs/design.md's table of the effects' parameters (checked against the declarations by
-/// `crates/monitor-analysis/tests/effect_parameters.rs`) come from it; an effect's typed values (e.g.
+/// `crates/monitor-analysis/tests/analysis/effect_parameters.rs`) come from it; an effect's typed values (e.g.
 /// `WindageValues`) are built from the fit's values in the declarations' order.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EffectParam {

@@ -4,7 +4,7 @@
 //! simulator and of `monitor_io::nameplate`), rounded as a nameplate prints it, and the
 //! estimate must give Rs, Rr, the total leakage Lls + Llr and Lm within 35 % of the
 //! circuit's. Also: the refusals name the field. (The command, `params from-nameplate`: its
-//! written TOML loads, its refusals name the option, its help: `sim-host/tests/nameplate.rs`.)
+//! written TOML loads, its refusals name the option, its help: `sim-host/tests/cli/nameplate.rs`.)
 
 use monitor_io::nameplate::{estimate, Connection, Nameplate, NemaDesign};
 use nalgebra::Complex;
@@ -301,7 +301,7 @@ fn good() -> Nameplate {
 }
 
 /// The message of refusing `n`: one line, starting with the field's name (the library's
-/// words; the command line says `--efficiency`, as `sim-host/tests/nameplate.rs` checks).
+/// words; the command line says `--efficiency`, as `sim-host/tests/cli/nameplate.rs` checks).
 fn refused(n: Nameplate, field: &str) -> String {
     let e = estimate(&n).expect_err("refused").to_string();
     assert!(e.starts_with(field), "{field}: {e}");

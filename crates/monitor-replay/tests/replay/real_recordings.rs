@@ -15,7 +15,7 @@
 //!   without voltages, at 1 and 10 kHz.
 //!
 //! (The command line's `--baseline` with several healthy runs or a folder:
-//! `sim-host/tests/real_recordings.rs`.)
+//! `sim-host/tests/cli/real_recordings.rs`.)
 
 use monitor_io::log::mapping::load_params;
 use monitor_io::log::{LogFile, OpenOptions, Row};

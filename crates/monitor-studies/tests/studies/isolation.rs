@@ -17,7 +17,7 @@
 //!   fault.
 //!
 //! (The command line's `diagnose` on a load step then a fault, with a parameter file that is
-//! off: `sim-host/tests/isolation.rs`.)
+//! off: `sim-host/tests/cli/isolation.rs`.)
 
 use monitor_core::Fault;
 use monitor_io::params::ParamFile;

@@ -1,4 +1,4 @@
-//! The textbook machine of `sim-host/tests/ladder_matrix.rs` (this crate's
+//! The textbook machine of `sim-host/tests/cli/ladder_matrix.rs` (this crate's
 //! `textbook_machine`) checked against physics, so that the ladder's bars rest on a model that can be trusted:
 //! * its steady state at rated slip equals the T-equivalent circuit's (analytic) torque
 //!   and current, on each of the three machines;

@@ -98,7 +98,7 @@ fn the_fault_level_on_logs_in_a_row_is_said_as_an_alarm_and_one_log_as_not_yet()
 }
 
 /// Four logs of one motor, Rs 0/+10/+20/+40 %, each a FAULT verdict, the load 6.4-7.6 A,
-/// e_d rising 0.0001 -> 0.026 (sim-host/tests/trend_view.rs's store).
+/// e_d rising 0.0001 -> 0.026 (sim-host/tests/cli/trend_view.rs's store).
 fn four_fault_logs() -> Vec<StoredRow> {
     let e_d = [0.0001, 0.0082, 0.0155, 0.026];
     let i1 = [6.4, 7.6, 7.0, 6.9];
