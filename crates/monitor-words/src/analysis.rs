@@ -9,7 +9,7 @@ use monitor_analysis::transients::{NotProposed, SPEED_CHANGE_MIN, STEP_MIN};
 use monitor_analysis::unbalance::{CannotJudgeUnbalance, UnbalanceAnalysis, UnbalanceFinding};
 use monitor_analysis::EffectId;
 use monitor_replay::OptionField;
-use serde_json::Value;
+use serde::Serialize;
 
 /// Effect names, comma separated.
 pub fn effect_names(kinds: &[EffectId]) -> String {
@@ -138,12 +138,27 @@ pub fn cannot_judge(why: &CannotJudgeUnbalance) -> String {
     }
 }
 
-/// The unbalance analysis' JSON object `v` (of `u`) with its sentences: `summary` and
-/// `cannot_judge_because` (null where judged).
-pub fn unbalance_into(v: &mut Value, u: &UnbalanceAnalysis, spell: &dyn Spelling) {
-    if let Some(o) = v.as_object_mut() {
-        o.insert("summary".into(), unbalance(u, spell).into());
-        let why = u.finding.cannot_judge().map(cannot_judge);
-        o.insert("cannot_judge_because".into(), why.into());
+/// The unbalance analysis as its JSON documents carry it (`compare`'s and `explain`'s
+/// `unbalance`): the typed analysis, and beside its `finding` the sentences spelled from it.
+#[derive(Debug, Clone, Serialize)]
+pub struct UnbalanceDoc<'a> {
+    /// The analysis' typed values (its ratios, suspect phase, phase currents and finding).
+    #[serde(flatten)]
+    pub analysis: &'a UnbalanceAnalysis,
+    /// The analysis in one sentence ([`unbalance`]).
+    pub summary: String,
+    /// Why the log cannot carry an unbalance claim ([`cannot_judge`]); `None` (JSON null)
+    /// where it was judged.
+    pub cannot_judge_because: Option<String>,
+}
+
+impl<'a> UnbalanceDoc<'a> {
+    /// The document of `u`, its sentences in `spell`'s words.
+    pub fn new(u: &'a UnbalanceAnalysis, spell: &dyn Spelling) -> Self {
+        UnbalanceDoc {
+            analysis: u,
+            summary: unbalance(u, spell),
+            cannot_judge_because: u.finding.cannot_judge().map(cannot_judge),
+        }
     }
 }

@@ -1,50 +1,136 @@
 //! `compare`'s words, spelled from [`monitor_analysis::compare`]'s typed values: the advice
 //! on transients, what could not run, what the log does not identify, why the fit is not
 //! plausible, and the JSON document that carries each sentence beside its typed value
-//! ([`document`]).
+//! ([`CompareDoc`], [`document`]).
 
-use crate::analysis::{not_proposed, unbalance_into};
+use crate::analysis::{not_proposed, UnbalanceDoc};
+use crate::leftover::LeftoverDoc;
 use crate::Spelling;
 use monitor_analysis::compare::{CompareReport, CompareSkip, NotIdentifiedBase, NotIdentifiedWhy};
-use monitor_analysis::metrics::DIVERGED_CURRENT_RATIO;
+use monitor_analysis::fit::Jacobian;
+use monitor_analysis::metrics::{ChannelError, WorstWindow, DIVERGED_CURRENT_RATIO};
 use monitor_analysis::transients::{Advice, Cover};
+use monitor_analysis::{DataInfo, EffectId, FittedEffect, ParamValue};
+use monitor_io::log::quality::DataQuality;
 use monitor_replay::OptionField;
+use serde::Serialize;
 use serde_json::Value;
+use std::collections::BTreeMap;
 
-/// `compare --json`'s document: the report's typed values with the sentences beside them
-/// (`advice` beside `advice_values`, `skipped` beside `skipped_reasons`, `not_identified`
-/// beside `not_identified_values`, `implausible_because` with a diverged prediction first,
-/// the unbalance's `summary` and `cannot_judge_because`, and where the error lives,
-/// `leftover.summary`); `spell` names the options the advice refers to.
+/// `compare --json`'s document: [`CompareDoc`], the report's typed values with the
+/// sentences beside them (`advice` beside `advice_values`, `skipped` beside
+/// `skipped_reasons`, `not_identified` beside `not_identified_values`,
+/// `implausible_because` with a diverged prediction first, the unbalance's `summary` and
+/// `cannot_judge_because`, and where the error lives, `leftover.summary`); `spell` names
+/// the options the advice refers to. As a JSON value, so that its keys print sorted at
+/// every level as the document always has (the workspace's `serde_json` keeps no insertion
+/// order).
 pub fn document(r: &CompareReport, spell: &dyn Spelling) -> Value {
-    let mut doc = serde_json::to_value(r).unwrap_or_default();
-    let Some(obj) = doc.as_object_mut() else {
-        return doc;
-    };
-    let strings = |v: Vec<String>| Value::from(v);
-    obj.insert(
-        "advice".into(),
-        strings(r.advice.iter().map(|a| advice(a, spell)).collect()),
-    );
-    obj.insert(
-        "skipped".into(),
-        strings(r.skipped.iter().map(|s| skipped(*s)).collect()),
-    );
-    obj.insert(
-        "not_identified".into(),
-        strings(r.not_identified.iter().map(not_identified).collect()),
-    );
-    let why = implausible(r, spell);
-    if !why.is_empty() {
-        obj.insert("implausible_because".into(), strings(why));
+    serde_json::to_value(CompareDoc::new(r, spell)).unwrap_or_default()
+}
+
+/// `compare`'s report as its JSON document carries it: each of [`CompareReport`]'s values
+/// under its own key (by reference; a field added to the report is a compile error in
+/// [`CompareDoc::new`] until the document carries it), with the sentences spelled from
+/// them beside them.
+#[derive(Debug, Clone, Serialize)]
+pub struct CompareDoc<'a> {
+    /// Effects in the model.
+    pub effects: &'a [EffectId],
+    /// Mean normalised RMS error over the channels.
+    pub normalized_rms_error: f64,
+    /// Where the model's prediction diverged [s] (absent when it did not).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub diverged_at_s: Option<f64>,
+    /// The error a perfect model would show (sensor noise) on the same measure.
+    pub noise_floor: f64,
+    /// Per-channel errors.
+    pub channels: &'a [ChannelError],
+    /// Where the model fails most.
+    pub worst_windows: &'a [WorstWindow],
+    /// What to do when the worst windows are transients, typed.
+    pub advice_values: &'a [Advice],
+    /// The same in words ([`advice`]).
+    pub advice: Vec<String>,
+    /// Fitted base parameters.
+    pub base_parameters: &'a BTreeMap<String, ParamValue>,
+    /// Fitted effects.
+    pub fitted_effects: &'a [FittedEffect],
+    /// False when a fitted value is outside its physical range.
+    pub plausible: bool,
+    /// Why not, in words ([`implausible`]: a diverged prediction first, then each value
+    /// out of range); absent when there is nothing to say.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub implausible_because: Vec<String>,
+    /// What the log identifies (null when the base parameters were not refitted).
+    pub identifiability: Option<&'a Jacobian>,
+    /// The base parameters the log does not identify, typed.
+    pub not_identified_values: &'a [NotIdentifiedBase],
+    /// The same in words ([`not_identified`]).
+    pub not_identified: Vec<String>,
+    /// Analyses that could not run, typed.
+    pub skipped_reasons: &'a [CompareSkip],
+    /// The same in words ([`skipped`]).
+    pub skipped: Vec<String>,
+    /// The unbalance analysis with its sentences.
+    pub unbalance: UnbalanceDoc<'a>,
+    /// Rows read, working rate, frame.
+    pub data: &'a DataInfo,
+    /// What the data-quality stage found and what the analysis did about it.
+    pub data_quality: &'a DataQuality,
+    /// Where the model's error lives, with its lines (null where the model could not run
+    /// or diverged).
+    pub leftover: Option<LeftoverDoc<'a>>,
+}
+
+impl<'a> CompareDoc<'a> {
+    /// The document of `r`, its sentences in `spell`'s words (the options advice refers to).
+    pub fn new(r: &'a CompareReport, spell: &dyn Spelling) -> Self {
+        let CompareReport {
+            effects,
+            normalized_rms_error,
+            diverged_at_s,
+            noise_floor,
+            channels,
+            worst_windows,
+            advice: advice_values,
+            base_parameters,
+            fitted_effects,
+            plausible,
+            implausible_because: _,
+            identifiability,
+            not_identified: not_identified_values,
+            skipped: skipped_reasons,
+            unbalance,
+            data,
+            data_quality,
+            leftover,
+        } = r;
+        CompareDoc {
+            effects,
+            normalized_rms_error: *normalized_rms_error,
+            diverged_at_s: *diverged_at_s,
+            noise_floor: *noise_floor,
+            channels,
+            worst_windows,
+            advice_values,
+            advice: advice_values.iter().map(|a| advice(a, spell)).collect(),
+            base_parameters,
+            fitted_effects,
+            plausible: *plausible,
+            // The typed list's values, with a diverged prediction said before them.
+            implausible_because: implausible(r, spell),
+            identifiability: identifiability.as_ref(),
+            not_identified_values,
+            not_identified: not_identified_values.iter().map(not_identified).collect(),
+            skipped_reasons,
+            skipped: skipped_reasons.iter().map(|s| skipped(*s)).collect(),
+            unbalance: UnbalanceDoc::new(unbalance, spell),
+            data,
+            data_quality,
+            leftover: leftover.as_ref().map(LeftoverDoc::new),
+        }
     }
-    if let Some(u) = obj.get_mut("unbalance") {
-        unbalance_into(u, &r.unbalance, spell);
-    }
-    if let (Some(v), Some(l)) = (obj.get_mut("leftover"), &r.leftover) {
-        crate::leftover::into_json(v, l);
-    }
-    doc
 }
 
 /// What to do about transients among the worst windows, one piece of advice (JSON

@@ -1,28 +1,18 @@
 //! `explain`'s words, spelled from [`monitor_analysis::explain`]'s typed values: the
-//! conclusion (JSON `verdict`), what was not fitted, the base parameters refitted, and the
-//! report's sentences put beside its typed values in a JSON document ([`report_into`]).
+//! conclusion (JSON `verdict`), the base parameters refitted, and the report's part of the
+//! JSON document, each sentence beside its typed value ([`ExplainReportDoc`]). What reads
+//! the one verdict (the headline, how the ranking reads beside the verdict, the whole
+//! document) is among the report's words ([`crate::diagnose`]: `explain_headline`,
+//! `beside_verdict`, `ExplainDoc`).
 
-use crate::analysis::{skipped, unbalance, unbalance_into};
+use crate::analysis::unbalance;
 use crate::Spelling;
 use monitor_analysis::explain::{ExplainConclusion, ExplainReport};
 use monitor_analysis::refit::BaseRefit;
 use monitor_replay::OptionField;
-use serde_json::Value;
 
-/// The report's JSON object `v` (of `r`) with its sentences: `verdict` beside
-/// `conclusion`, `skipped` beside `skipped_reasons`, and the unbalance's `summary` and
-/// `cannot_judge_because`; `spell` names the options advice refers to.
-pub fn report_into(v: &mut Value, r: &ExplainReport, spell: &dyn Spelling) {
-    let Some(obj) = v.as_object_mut() else {
-        return;
-    };
-    obj.insert("verdict".into(), verdict(r, spell).into());
-    let s: Vec<String> = r.skipped.iter().map(|s| skipped(s, spell)).collect();
-    obj.insert("skipped".into(), s.into());
-    if let Some(u) = obj.get_mut("unbalance") {
-        unbalance_into(u, &r.unbalance, spell);
-    }
-}
+mod doc;
+pub use doc::ExplainReportDoc;
 
 /// `explain`'s conclusion in words (JSON `verdict`), naming the numbers that decided, with
 /// the notes on the candidates not named because their fits are not physical and on a

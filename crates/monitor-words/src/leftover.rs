@@ -1,8 +1,8 @@
 //! Where the leftover lives, in words ([`monitor_analysis::leftover`]): a few short lines
 //! (none over [`LINE_MAX`] characters) that say which equations, which windows, which
 //! frequencies and what the model's remaining error follows, and the law it points to;
-//! and the same lines in the JSON (`leftover.summary`, and each line's reading as
-//! `leftover.lines[].says`).
+//! and the same lines in the JSON document [`LeftoverDoc`] (`leftover.summary`, and each
+//! line's reading as `leftover.lines[].says`).
 
 use monitor_analysis::effects::sig;
 use monitor_analysis::leftover::{
@@ -10,7 +10,9 @@ use monitor_analysis::leftover::{
     NoSpectrum, OperatingVariable, ShaftAngle, Stretches, ANGLE_SHARE_MIN,
 };
 use monitor_analysis::strata::StratumKind;
-use serde_json::Value;
+
+mod doc;
+pub use doc::{LeftoverDoc, LineDoc};
 
 /// The longest line spelled here [characters].
 pub const LINE_MAX: usize = 160;
@@ -341,22 +343,6 @@ pub fn hint(h: LawHint) -> String {
         }
         LawHint::MagnetisingOfFlux => {
             "a magnetising inductance of the flux psi_m (acts_on = \"magnetising_inductance\"), or a no-load table".into()
-        }
-    }
-}
-
-/// The leftover's sentences into its JSON value `v` (the serialised `l`): `summary` (the
-/// lines of [`lines`]) and each spectral line's reading as `says`.
-pub fn into_json(v: &mut Value, l: &Leftover) {
-    let Some(obj) = v.as_object_mut() else {
-        return;
-    };
-    obj.insert("summary".into(), lines(l).into());
-    if let Some(ls) = obj.get_mut("lines").and_then(Value::as_array_mut) {
-        for (j, x) in ls.iter_mut().zip(&l.lines) {
-            if let Some(o) = j.as_object_mut() {
-                o.insert("says".into(), reading(&x.reading).into());
-            }
         }
     }
 }

@@ -379,7 +379,7 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
         (&out.before, out.after.as_ref()),
         &doc,
     )?;
-    print_explain(c, &doc, judged.as_ref().ok(), compared.as_ref())
+    print_explain(c, &doc, compared.as_ref())
 }
 
 /// `explain`'s document on standard output: its JSON (after `compare`'s with `--compare`),
@@ -387,10 +387,9 @@ pub fn run_explain(args: &ExplainArgs) -> anyhow::Result<()> {
 fn print_explain(
     c: &Common,
     doc: &monitor_api::ExplainDocument,
-    judged: Option<&monitor_api::replay::DiagnoseReport>,
     compared: Option<&monitor_api::analysis::CompareReport>,
 ) -> anyhow::Result<()> {
-    let json = c.json.then(|| doc.json(judged, &super::words::CliWords));
+    let json = c.json.then(|| doc.json(&super::words::CliWords));
     match (json, compared) {
         (Some(explain), Some(cmp)) => render::json::print(
             &mut crate::cli::out::stdout(),

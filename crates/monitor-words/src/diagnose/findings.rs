@@ -8,10 +8,32 @@ use monitor_io::log::quality::MAX_NOT_JUDGED_FRACTION;
 use monitor_replay::{Detail, DiagnoseReport, FileMisfit, FindingReport, RangeDeparture};
 
 use crate::spelling::Spelling;
+use serde::Serialize;
+use std::borrow::Borrow;
 
 /// The finding's sentence (JSON `findings[].summary`).
 pub fn summary(f: &FindingReport, rep: &DiagnoseReport, sp: &dyn Spelling) -> String {
     summary_of(&f.detail, rep, sp)
+}
+
+/// A finding as a JSON document carries it (`explain`'s `verdict_finding`): its typed
+/// values (`source`, `state`, `fault`, ..., `reason`) and beside them its sentence. `F` is
+/// the finding, owned ([`FindingReport`]) or lent (`&FindingReport`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FindingDoc<F> {
+    /// The finding's typed values.
+    #[serde(flatten)]
+    pub finding: F,
+    /// Its sentence ([`summary`]).
+    pub summary: String,
+}
+
+impl<F: Borrow<FindingReport>> FindingDoc<F> {
+    /// The document of `finding`, one of `rep`'s, its sentence in `sp`'s words.
+    pub fn new(finding: F, rep: &DiagnoseReport, sp: &dyn Spelling) -> Self {
+        let summary = summary(finding.borrow(), rep, sp);
+        FindingDoc { finding, summary }
+    }
 }
 
 /// The isolation's verdict of the report.

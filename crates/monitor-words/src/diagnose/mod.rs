@@ -8,6 +8,7 @@
 //! each its sentence under the key it has always had (`summary`, `verdict`,
 //! `phase_not_judged`, `cannot_judge_because`, ...).
 
+mod beside_explain;
 mod commissioning;
 mod findings;
 mod isolation;
@@ -17,11 +18,12 @@ mod rotor;
 mod verdict;
 mod winding;
 
+pub use beside_explain::{beside_verdict, explain_headline, ExplainDoc};
 pub use commissioning::{
     advice, first_point_misfit, not_learned, not_learned_why, note, quantity, range_note, skipped,
     thresholds,
 };
-pub use findings::{brief, summary};
+pub use findings::{brief, summary, FindingDoc};
 pub use isolation::{channel_dropped, channel_use, event_line, group_reason, moved_note, said};
 pub use rotor::{band_words, load_unknown, load_words};
 pub use verdict::{

@@ -1,9 +1,10 @@
 //! The ladder's words (`explain --ladder`), spelled from
 //! [`monitor_analysis::explain::ladder`]'s typed values: why it stopped, why a candidate was
 //! not kept, each step, the base changes, what was found, and the JSON document that
-//! carries each sentence beside the typed reason it is spelled from ([`document`]).
+//! carries each sentence beside the typed reason it is spelled from ([`LadderDoc`],
+//! [`document`]).
 
-use crate::analysis::{effect_names, skipped};
+use crate::analysis::effect_names;
 use crate::Spelling;
 use monitor_analysis::effects::sig;
 use monitor_analysis::explain::ladder::{
@@ -14,46 +15,20 @@ use monitor_analysis::EffectId;
 use serde_json::Value;
 
 mod base;
+mod doc;
 use base::apart;
 pub use base::{base_change, base_changes};
+pub use doc::{LadderDoc, StepDoc, TriedDoc};
 
-/// `explain --ladder --json`'s document: the report's typed values, with the sentences a
-/// crew reads beside them (`summary`, `stopped_because` beside `stopped_reason`, `skipped`
-/// beside `skipped_reasons`, `test` beside `test_rule`, each step's `summary`, each
-/// candidate's `because` beside its `refusal`, and where the error lives when the ladder
-/// stops above the floor, `leftover.summary`); `spell` names the options advice refers to.
+/// `explain --ladder --json`'s document: [`LadderDoc`], the report's typed values with
+/// the sentences a crew reads beside them (`summary`, `stopped_because` beside
+/// `stopped_reason`, `skipped` beside `skipped_reasons`, `test` beside `test_rule`, each
+/// step's `summary`, each candidate's `because` beside its `refusal`, and where the error
+/// lives when the ladder stops above the floor, `leftover.summary`); `spell` names the
+/// options advice refers to. As a JSON value, so that its keys print sorted at every level
+/// as the document always has (the workspace's `serde_json` keeps no insertion order).
 pub fn document(r: &LadderReport, spell: &dyn Spelling) -> Value {
-    let mut doc = serde_json::to_value(r).unwrap_or_default();
-    let Some(obj) = doc.as_object_mut() else {
-        return doc;
-    };
-    obj.insert("summary".into(), summary(r).into());
-    obj.insert("stopped_because".into(), stopped(r).into());
-    obj.insert("test".into(), test(&r.test_rule).into());
-    let skipped: Vec<Value> = r
-        .skipped_reasons
-        .iter()
-        .map(|s| skipped(s, spell).into())
-        .collect();
-    obj.insert("skipped".into(), skipped.into());
-    if let Some(steps) = obj.get_mut("ladder").and_then(Value::as_array_mut) {
-        for (v, s) in steps.iter_mut().zip(&r.ladder) {
-            if let Some(o) = v.as_object_mut() {
-                o.insert("summary".into(), step(s).into());
-            }
-        }
-    }
-    if let Some(tried) = obj.get_mut("last_round").and_then(Value::as_array_mut) {
-        for (v, t) in tried.iter_mut().zip(&r.last_round) {
-            if let Some(o) = v.as_object_mut() {
-                o.insert("because".into(), refusal(&t.refusal).into());
-            }
-        }
-    }
-    if let (Some(v), Some(l)) = (obj.get_mut("leftover"), &r.leftover) {
-        crate::leftover::into_json(v, l);
-    }
-    doc
+    serde_json::to_value(LadderDoc::new(r, spell)).unwrap_or_default()
 }
 
 /// Why the ladder stopped, naming the numbers that decided (JSON `stopped_because`).
