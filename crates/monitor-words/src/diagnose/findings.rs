@@ -16,8 +16,9 @@ pub fn summary(f: &FindingReport, rep: &DiagnoseReport, sp: &dyn Spelling) -> St
     summary_of(&f.detail, rep, sp)
 }
 
-/// A finding as a JSON document carries it (`explain`'s `verdict_finding`): its typed
-/// values (`source`, `state`, `fault`, ..., `reason`) and beside them its sentence. `F` is
+/// A finding as a JSON document carries it (`diagnose`'s `findings[]` and
+/// `verdict_finding`, `explain`'s `verdict_finding`): its typed values (`source`, `state`,
+/// `fault`, ..., `reason`) and beside them its sentence. `F` is
 /// the finding, owned ([`FindingReport`]) or lent (`&FindingReport`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FindingDoc<F> {

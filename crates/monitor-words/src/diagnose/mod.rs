@@ -2,14 +2,16 @@
 //! report, the JSON document, the HMI, Python) spelled from the report's typed findings, in
 //! one place, so that no two lines disagree.
 //!
-//! [`Story`] spells a report once; [`document`] is `diagnose --json`'s document: the
-//! report's typed values (the findings with their `reason`, the isolation's `said`, the
+//! [`Story`] spells a report once; [`DiagnoseDoc`] ([`document`]) is `diagnose --json`'s
+//! document: the report's typed values (the findings with their `reason`, the isolation's `said`, the
 //! winding's `phase_not_judged_reason`, the rotor's `cannot_judge_reason`, ...) and beside
 //! each its sentence under the key it has always had (`summary`, `verdict`,
 //! `phase_not_judged`, `cannot_judge_because`, ...).
 
 mod beside_explain;
 mod commissioning;
+mod doc;
+mod doc_parts;
 mod findings;
 mod isolation;
 pub mod machine_fit;
@@ -23,6 +25,8 @@ pub use commissioning::{
     advice, first_point_misfit, not_learned, not_learned_why, note, quantity, range_note, skipped,
     thresholds,
 };
+pub use doc::{CommissioningDoc, DiagnoseDoc, RangeNoteDoc, TimelinePointDoc, UnbalanceReportDoc};
+pub use doc_parts::{GroupDoc, IsolationDoc, RotorDoc, RotorLoadDoc};
 pub use findings::{brief, summary, FindingDoc};
 pub use isolation::{channel_dropped, channel_use, event_line, group_reason, moved_note, said};
 pub use rotor::{band_words, load_unknown, load_words};
@@ -172,13 +176,6 @@ pub fn state_note(s: &MonitorState) -> Option<String> {
     }
 }
 
-/// Puts `value` at `key` of the object `v` (nothing where `v` is not an object).
-fn put(v: &mut Value, key: &str, value: impl Into<Value>) {
-    if let Some(m) = v.as_object_mut() {
-        m.insert(key.to_string(), value.into());
-    }
-}
-
 /// A first detection of the lamps' signature matching as the report's events list it,
 /// beside the verdict: the fault the verdict names, or why the verdict does not name it
 /// (the lamps' four residuals carry two equations' worth: Table 1 shares a row between
@@ -201,90 +198,12 @@ pub fn detection_line(d: &monitor_replay::Detection, rep: &DiagnoseReport) -> St
     }
 }
 
-/// `diagnose --json`'s document of `rep`: its typed values, and beside each its sentence
-/// under the key the document has always had, in `sp`'s words.
+/// `diagnose --json`'s document of `rep`: [`DiagnoseDoc`], its typed values and beside
+/// each its sentence under the key the document has always had, in `sp`'s words. As a JSON
+/// value, so that its keys print sorted at every level as the document always has (the
+/// workspace's `serde_json` keeps no insertion order).
 pub fn document(rep: &DiagnoseReport, sp: &dyn Spelling) -> Value {
-    let story = Story::of(rep, sp);
-    let mut v = serde_json::to_value(rep).unwrap_or_default();
-    put_story(&mut v, rep, &story, sp);
-    v
-}
-
-/// The sentences of `story` put into the document `v` of `rep`.
-fn put_story(v: &mut Value, rep: &DiagnoseReport, story: &Story, sp: &dyn Spelling) {
-    put(v, "verdict_line", story.verdict_line.clone());
-    put(v, "judged", story.judged.clone());
-    put(v, "not_judged", story.not_judged.clone());
-    put(
-        v,
-        "verdict_withheld_because",
-        story.withheld_because.clone(),
-    );
-    put(v, "skipped", story.skipped.clone());
-    put(
-        v,
-        "detections_said",
-        rep.detections
-            .iter()
-            .map(|d| detection_line(d, rep))
-            .collect::<Vec<_>>(),
-    );
-    if let Some(fs) = v.get_mut("findings").and_then(Value::as_array_mut) {
-        for (f, (s, _)) in fs.iter_mut().zip(&story.findings) {
-            put(f, "summary", s.clone());
-        }
-    }
-    if let (Some(f), Some(vf)) = (rep.verdict_finding.as_ref(), v.get_mut("verdict_finding")) {
-        put(vf, "summary", summary(f, rep, sp));
-    }
-    if let Some(c) = v.get_mut("commissioning") {
-        put(c, "thresholds", story.thresholds.clone());
-        put(c, "advice", story.advice.clone());
-        if let Some(notes) = c.get_mut("outside_range").and_then(Value::as_array_mut) {
-            for (n, s) in notes.iter_mut().zip(&story.outside_range) {
-                put(n, "note", s.clone());
-            }
-        }
-    }
-    if let Some(i) = v.get_mut("isolation") {
-        put(i, "verdict", story.isolation.clone());
-        if let Some(t) = &story.temperature_channel {
-            put(i, "temperature_channel", t.clone());
-        }
-        if let Some(gs) = i.get_mut("groups").and_then(Value::as_array_mut) {
-            for (g, s) in gs.iter_mut().zip(&story.groups) {
-                put(g, "reason", s.clone());
-            }
-        }
-    }
-    if let Some(u) = v.get_mut("unbalance") {
-        put(u, "phase_not_judged", story.phase_not_judged.clone());
-        put(
-            u,
-            "least_change_widened",
-            story.least_change_widened.clone(),
-        );
-    }
-    put_rotor_and_timeline(v, story);
-}
-
-/// The rotor's sentences and the timeline's notes of [`put_story`].
-fn put_rotor_and_timeline(v: &mut Value, story: &Story) {
-    if let Some(r) = v.get_mut("rotor") {
-        put(r, "sentence", story.rotor.clone());
-        put(r, "cannot_judge_because", story.rotor_cannot.clone());
-        put(r, "band_meaning", story.rotor_band.clone());
-        if let Some(l) = r.get_mut("load").filter(|l| l.is_object()) {
-            put(l, "unknown_because", story.rotor_load_unknown.clone());
-        }
-    }
-    if let Some(ps) = v.get_mut("timeline").and_then(Value::as_array_mut) {
-        for (p, n) in ps.iter_mut().zip(&story.timeline_notes) {
-            if let Some(n) = n {
-                put(p, "range_note", n.clone());
-            }
-        }
-    }
+    serde_json::to_value(DiagnoseDoc::new(rep, sp)).unwrap_or_default()
 }
 
 #[cfg(test)]
