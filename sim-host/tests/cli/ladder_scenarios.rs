@@ -441,7 +441,13 @@ fn a_sagging_supply_is_not_a_warm_stator() {
             .as_array()
             .unwrap()
             .iter()
-            .find(|s| s["added"].as_array().unwrap().iter().any(|e| e == "thermal_drift"))
+            .find(|s| {
+                s["added"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .any(|e| e == "thermal_drift")
+            })
             .cloned()
     };
     let sag = climb(false);
@@ -450,11 +456,22 @@ fn a_sagging_supply_is_not_a_warm_stator() {
         "a sagging supply read as a warming: {}",
         sag["summary"]
     );
-    assert_eq!(sag["base_changes"], serde_json::json!([]), "{}", sag["summary"]);
+    assert_eq!(
+        sag["base_changes"],
+        serde_json::json!([]),
+        "{}",
+        sag["summary"]
+    );
     let alike = &sag["final_fit"]["alike"];
-    assert!(alike.is_null() || alike == &serde_json::json!([]), "{alike}");
+    assert!(
+        alike.is_null() || alike == &serde_json::json!([]),
+        "{alike}"
+    );
     let warm = climb(true);
     let step = drift_step(&warm).unwrap_or_else(|| panic!("no drift named: {}", warm["summary"]));
     let rise = step["fitted"]["stator_rise_k"]["value"].as_f64().unwrap();
-    assert!((rise - 30.0).abs() <= 7.5, "stator rise {rise:.1} K, 30 K injected");
+    assert!(
+        (rise - 30.0).abs() <= 7.5,
+        "stator rise {rise:.1} K, 30 K injected"
+    );
 }

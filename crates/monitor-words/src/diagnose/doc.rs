@@ -108,16 +108,12 @@ impl<'a> DiagnoseDoc<'a> {
             timeline,
             threshold_bands,
         } = rep;
+        let finding = |f| FindingDoc::new(f, rep, sp);
         DiagnoseDoc {
             verdict: *verdict,
             verdict_rule: *verdict_rule,
-            verdict_finding: verdict_finding
-                .as_ref()
-                .map(|f| FindingDoc::new(f, rep, sp)),
-            findings: findings
-                .iter()
-                .map(|f| FindingDoc::new(f, rep, sp))
-                .collect(),
+            verdict_finding: verdict_finding.as_ref().map(finding),
+            findings: findings.iter().map(finding).collect(),
             lamps,
             candidates,
             isolation: IsolationDoc::new(isolation, sp),
