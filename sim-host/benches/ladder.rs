@@ -86,8 +86,8 @@ fn main() {
         let named: Vec<&str> = r
             .final_effects
             .iter()
+            .filter(|k| !k.is_dynamics())
             .map(|k| k.name())
-            .filter(|n| !n.ends_with("_dynamics"))
             .collect();
         let end = r.final_fit.as_ref().map_or(f64::NAN, |f| f.ratio_to_floor);
         println!(
